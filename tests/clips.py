@@ -1,0 +1,66 @@
+"""Test clips written with PyAV, from a function of the frame index (float RGB, 0-255)."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+from typing import Callable
+
+import av
+import numpy as np
+
+
+def write_clip(
+    path: Path,
+    frame_fn: Callable[[int], np.ndarray],
+    n: int,
+    *,
+    fps: Fraction | int = 30,
+    codec: str = "libx264",
+    pix_fmt: str = "yuv420p",
+    options: dict | None = None,
+    fmt: str | None = None,
+    pts_fn: Callable[[int], int] | None = None,
+    time_base: Fraction | None = None,
+    audio: bool = False,
+) -> Path:
+    """Encode ``n`` frames; ``frame_fn(i)`` gives float RGB, quantised here (as a camera would)."""
+    fps = Fraction(fps)
+    with av.open(str(path), "w", format=fmt) as c:
+        s = c.add_stream(codec, rate=fps)
+        first = np.asarray(frame_fn(0))
+        s.height, s.width = first.shape[:2]
+        s.pix_fmt = pix_fmt
+        if options is None and codec == "libx264":
+            options = {"crf": "0" if pix_fmt == "yuv444p" else "12", "preset": "ultrafast"}
+        if options:
+            s.options = options
+        if time_base is not None:
+            s.time_base = time_base
+        if pix_fmt.startswith("yuv"):
+            s.codec_context.colorspace = 6
+            s.codec_context.color_range = 1
+        a = c.add_stream("aac", rate=8000) if audio else None
+        for i in range(n):
+            img = first if i == 0 else np.asarray(frame_fn(i))
+            if img.ndim == 2:
+                frame = av.VideoFrame.from_ndarray(np.clip(np.rint(img), 0, 255).astype(np.uint8), format="gray")
+            else:
+                frame = av.VideoFrame.from_ndarray(np.clip(np.rint(img), 0, 255).astype(np.uint8), format="rgb24")
+            if pts_fn is not None:
+                frame.pts = pts_fn(i)
+                frame.time_base = s.time_base
+            for p in s.encode(frame):
+                c.mux(p)
+            if a is not None:
+                samples = np.zeros((1, int(8000 / float(fps))), np.float32)
+                af = av.AudioFrame.from_ndarray(samples, format="fltp", layout="mono")
+                af.sample_rate = 8000
+                for p in a.encode(af):
+                    c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+        if a is not None:
+            for p in a.encode():
+                c.mux(p)
+    return Path(path)

@@ -1,0 +1,148 @@
+"""The typer app and ``main()``: the only place that maps failures to exit codes.
+
+Command modules are imported here, so they import only typer and the standard library at
+module level; numpy, PyAV, OpenCV, onnxruntime and matplotlib load inside the commands, which
+keeps ``wallcli --help`` and ``--version`` fast.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import typer
+
+from wallcli import __version__
+
+HELP = """\
+Learn what happens in a hidden part of a room by staring at a blank wall.
+
+People moving out of the camera's view change the light on a visible wall by 0.1-1 %.
+wallcli recovers that signal from an ordinary video: it removes each pixel's temporal
+mean, averages the wall over many pixels (noise falls as 1/sqrt(pixels)), and reads the
+resulting space-time plots.
+
+\b
+Pipeline:  wallcli snr clip.mp4 --roi auto        # is there any signal, and where?
+           wallcli stplot clip.mp4 -o p.npz --png p.png
+           wallcli count p.npz --json              # 0, 1 or 2 people
+           wallcli activity clip.mp4               # none/walking/crouching/waving/jumping
+           wallcli amplify clip.mp4 amp.mp4        # see the invisible signal
+
+Exit codes: 0 success, 1 input or work failed, 2 usage error.  WALLCLI_DEBUG=1 shows tracebacks.
+"""
+
+app = typer.Typer(
+    help=HELP,
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    rich_markup_mode=None,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+def _version(value: bool) -> None:
+    if value:
+        print(f"wallcli {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", "-V", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
+    pass
+
+
+def _register() -> None:
+    # Each command lives in its own module; a module that is not there yet simply adds nothing.
+    import importlib
+
+    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train"):
+        try:
+            mod = importlib.import_module(f"wallcli.cli.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"wallcli.cli.{name}":
+                continue
+            raise
+        app.command(name)(getattr(mod, name))
+
+
+_register()
+
+
+def _debug() -> bool:
+    return os.environ.get("WALLCLI_DEBUG", "") not in ("", "0")
+
+
+def _fail(message: str, code: int) -> None:
+    # One line on stderr, always: scripts grep for it and humans read it.
+    message = " ".join(str(message).split())
+    sys.stderr.write(f"Error: {message}\n")
+    sys.stderr.flush()
+    sys.exit(code)
+
+
+def _click_exceptions():
+    # typer >= 0.16 vendors click as typer._click; older ones depend on click itself.
+    try:
+        from click.exceptions import Abort, ClickException, Exit, UsageError
+    except ImportError:
+        from typer._click.exceptions import ClickException, UsageError
+        from typer.exceptions import Abort, Exit
+    return Abort, ClickException, Exit, UsageError
+
+
+def main(argv: list[str] | None = None) -> None:
+    from wallcli.errors import WallcliError
+
+    Abort, ClickException, Exit, ClickUsageError = _click_exceptions()
+
+    import warnings
+
+    def _show(message, category, *args, **kwargs):  # warnings: one line on stderr, no source line
+        sys.stderr.write(f"Warning: {message}\n")
+
+    warnings.showwarning = _show
+    command = typer.main.get_command(app)
+    try:
+        command.main(args=argv, prog_name="wallcli", standalone_mode=False)
+    except WallcliError as exc:
+        if _debug():
+            raise
+        _fail(str(exc), exc.exit_code)
+    except Exit as exc:
+        sys.exit(exc.exit_code)
+    except Abort:
+        _fail("interrupted", 130)
+    except ClickUsageError as exc:
+        if _debug():
+            raise
+        if type(exc).__name__ == "NoArgsIsHelpError":  # bare `wallcli` / `wallcli CMD`: show help
+            sys.stderr.write(exc.ctx.get_help() + "\n" if exc.ctx else "")
+            sys.exit(2)
+        path = exc.ctx.command_path if exc.ctx else "wallcli"
+        _fail(f"{exc.format_message()} (see '{path} --help')", 2)
+    except ClickException as exc:
+        if _debug():
+            raise
+        _fail(exc.format_message(), exc.exit_code or 1)
+    except KeyboardInterrupt:
+        if _debug():
+            raise
+        _fail("interrupted", 130)
+    except BrokenPipeError:
+        # `wallcli ... | head`: the reader left; not our failure.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        sys.exit(1)
+    except MemoryError:
+        if _debug():
+            raise
+        _fail("out of memory", 1)
+    except Exception as exc:  # noqa: BLE001 - the last line of defence keeps the one-line promise
+        if _debug():
+            raise
+        _fail(f"internal error: {type(exc).__name__}: {exc} (set WALLCLI_DEBUG=1 for a traceback and report it)", 1)

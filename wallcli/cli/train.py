@@ -1,0 +1,130 @@
+"""``wallcli train count|activity --data DIR --out models/NAME.onnx``: train, export, write the card."""
+from __future__ import annotations
+
+from enum import Enum
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+INSTALL_HINT = "pip install torch==2.13.0 && pip install 'wallcli[train]'"
+
+
+class Task(str, Enum):
+    count = "count"
+    activity = "activity"
+
+
+def train(
+    task: Task = typer.Argument(..., help="Which network: 'count' (0/1/2 people) or 'activity'."),
+    data: Path = typer.Option(..., "--data", help="Dataset folder from the simulator (dataset.json + shards)."),
+    out: Path = typer.Option(..., "--out", "-o", help="Model to write (.onnx); its card goes beside it (.json)."),
+    val: Optional[Path] = typer.Option(None, "--val", help="Validation dataset folder (default: hold out --val-fraction of --data)."),
+    val_fraction: float = typer.Option(0.1, "--val-fraction", min=0.0, max=0.5, help="Share of --data held out when there is no --val."),
+    epochs: int = typer.Option(20, "--epochs", min=1, help="Total epochs (a resumed run continues up to this)."),
+    batch_size: int = typer.Option(32, "--batch-size", min=2, help="Windows per optimisation step."),
+    threads: int = typer.Option(0, "--threads", min=0, help="Torch CPU threads (0: torch's default)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of initialisation, split, batch order and augmentation."),
+    checkpoint: Optional[Path] = typer.Option(None, "--checkpoint", help="Checkpoint file (default: OUT with suffix .ckpt.pt)."),
+    checkpoint_minutes: float = typer.Option(5.0, "--checkpoint-minutes", min=0.1, help="Minutes between checkpoints within an epoch."),
+    resume: bool = typer.Option(True, "--resume/--no-resume", help="Continue from the checkpoint when it exists."),
+    augment: bool = typer.Option(True, "--augment/--no-augment", help="Label-preserving augmentation (see wallcli/train/augment.py)."),
+    name: Optional[str] = typer.Option(None, "--name", help="Model name in the card (default: wallcli-TASK)."),
+    model_version: str = typer.Option("1.0.0", "--model-version", help="Model version in the card."),
+    stride: int = typer.Option(64, "--stride", min=1, help="Default inference stride recorded in the card (frames)."),
+    force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
+) -> None:
+    """Train the seed's CNN on simulator windows and export it to ONNX with a model card."""
+    try:
+        import torch  # noqa: F401
+    except ImportError:
+        from wallcli.errors import WallcliError
+
+        raise WallcliError("training needs PyTorch, which is not installed", hint=INSTALL_HINT) from None
+
+    from wallcli.cli.output import console_err, log
+    from wallcli.errors import UsageError
+    from wallcli.infer.card import card_path
+    from wallcli.io.writer import check_output
+    from wallcli.train.augment import DESCRIPTION
+    from wallcli.train.export import export_model
+    from wallcli.train.loop import TrainConfig, train as run_training
+
+    if out.suffix.lower() != ".onnx":
+        raise UsageError(f"--out must end in .onnx: {out}")
+    check_output(out, force=force)
+    check_output(card_path(out), force=force)
+    cfg = TrainConfig(task=task.value, data=data, out=out, val=val, val_fraction=val_fraction, epochs=epochs,
+                      batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
+                      checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment)
+
+    with _TrainProgress(console_err) as bar:
+        result = run_training(cfg, bar.event)
+
+    ds = result["dataset"]
+    vds = result["val_dataset"]
+    validation = None
+    if result["validation"] is not None:
+        v = result["validation"]
+        validation = {
+            "source": ({"dataset": str(val), "recipe": vds.manifest.get("recipe"), "seed": vds.manifest.get("seed")}
+                       if vds is not None else f"{val_fraction:.0%} of the training dataset held out (seed {seed})"),
+            "windows": v["windows"], "accuracy": v["accuracy"], "loss": v["loss"],
+            "confusion_matrix": v["confusion_matrix"],
+            "confusion_matrix_axes": "rows: true class, columns: predicted class, both in the order of classes",
+            "epoch": result["best_epoch"],
+        }
+    fields = dict(
+        name=name or f"wallcli-{task.value}", version=model_version, task=task.value, classes=ds.classes, stride=stride,
+        training_data={"dataset": str(data), "recipe": ds.manifest.get("recipe"), "seed": ds.manifest.get("seed"),
+                       "windows": ds.n, "train_windows": result["train_windows"]},
+        training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
+                  "loss": "cross-entropy", "augmentation": DESCRIPTION if augment else [],
+                  "selected_epoch": result["best_epoch"], "history": result["history"],
+                  "command": f"wallcli train {task.value} --data {data} --out {out} --epochs {epochs} "
+                             f"--batch-size {batch_size} --seed {seed}" + (f" --val {val}" if val else "")},
+        validation=validation,
+    )
+    card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed)
+    acc = f", validation accuracy {validation['accuracy']:.1%} on {validation['windows']} windows" if validation else ""
+    log(f"wrote {out} and {card_path(out).name} (sha256 {card['sha256'][:12]}…){acc}")
+
+
+class _TrainProgress:
+    """Progress bar with running loss/accuracy; plain epoch lines when stderr is not a terminal."""
+
+    def __init__(self, console) -> None:
+        self.console = console
+        self.bar = None
+        self.task = None
+
+    def __enter__(self) -> "_TrainProgress":
+        if self.console.is_terminal:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+            self.bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                TextColumn("loss {task.fields[loss]:.4f} acc {task.fields[acc]:.1%}"),
+                                TimeElapsedColumn(), TimeRemainingColumn(), console=self.console)
+            self.bar.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(*exc)
+
+    def event(self, kind: str, **f) -> None:
+        if kind == "resume":
+            self.console.print(f"resuming from {f['path']} at epoch {f['epoch'] + 1}, batch {f['batch']}")
+        elif kind == "epoch_start" and self.bar is not None:
+            if self.task is not None:
+                self.bar.remove_task(self.task)
+            self.task = self.bar.add_task(f"epoch {f['epoch'] + 1}/{f['epochs']}", total=f["batches"],
+                                          completed=f["done"], loss=float("nan"), acc=0.0)
+        elif kind == "step" and self.bar is not None:
+            self.bar.update(self.task, completed=f["batch"], loss=f["loss"], acc=f["accuracy"])
+        elif kind == "epoch_end":
+            val = f"  val acc {f['val_accuracy']:.1%} loss {f['val_loss']:.4f}" if f["val_accuracy"] is not None else ""
+            loss = f"{f['train_loss']:.4f}" if f["train_loss"] is not None else "-"
+            acc = f"{f['train_accuracy']:.1%}" if f["train_accuracy"] is not None else "-"
+            self.console.print(f"epoch {f['epoch']}: loss {loss} acc {acc}  "
+                               f"{f['train_windows_per_s']:.1f} windows/s{val}")

@@ -1,0 +1,160 @@
+"""A classifier model: an .onnx file, its card, and a lazily created onnxruntime session.
+
+The file's bytes are read once, hashed and compared with the card's sha256 before any
+session exists, and the session is built from those same bytes, so the model that runs is
+the model that was checked (no window between the check and the load).
+"""
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+from wallcli.infer.card import OUTPUT_NAME, read_card, sha256_bytes
+
+SHIPPED = {"count": "count.onnx", "activity": "activity.onnx"}
+
+
+def shipped_model_path(task: str) -> Path:
+    """The model shipped inside the wheel (package data ``wallcli/models/``).
+
+    In a source checkout the models live in the repository's top-level ``models/``;
+    packaging maps that folder to ``wallcli/models`` in the wheel.
+    """
+    name = SHIPPED[task]
+    try:
+        res = resources.files("wallcli") / "models" / name
+        if res.is_file():
+            return Path(str(res))
+    except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
+        pass
+    return Path(__file__).resolve().parents[2] / "models" / name
+
+
+class Model:
+    def __init__(self, path: Path, card: dict[str, Any], data: bytes, threads: int = 0) -> None:
+        self.path = Path(path)
+        self.card = card
+        self._data = data
+        self.threads = threads
+        self._session = None
+
+    @classmethod
+    def load(cls, path: Path | str, *, task: str | None = None, threads: int = 0) -> "Model":
+        path = Path(path)
+        if not path.is_file():
+            raise WallcliError(f"model not found: {path}")
+        card = read_card(path)
+        if task is not None and card["task"] != task:
+            raise WallcliError(f"{path} is a {card['task']!r} model, but this command needs a {task!r} model")
+        data = path.read_bytes()
+        digest = sha256_bytes(data)
+        if digest != card["sha256"].lower():
+            raise WallcliError(
+                f"model {path} does not match its card (sha256 {digest[:12]}…, card says {card['sha256'][:12]}…)",
+                hint="the model file was modified or the card belongs to another model; re-export or re-install it")
+        return cls(path, card, data, threads)
+
+    # -- card shortcuts ---------------------------------------------------------------
+    @property
+    def task(self) -> str:
+        return self.card["task"]
+
+    @property
+    def classes(self) -> list[Any]:
+        return list(self.card["classes"])
+
+    @property
+    def input_names(self) -> list[str]:
+        return [i["name"] for i in self.card["inputs"]]
+
+    @property
+    def window(self) -> int:
+        return int(self.card["window"])
+
+    @property
+    def bins(self) -> int:
+        return int(self.card["bins"])
+
+    @property
+    def fps(self) -> float:
+        return float(self.card["fps"])
+
+    def info(self) -> dict[str, str]:
+        return {"name": self.card["name"], "version": self.card["version"], "sha256": self.card["sha256"]}
+
+    # -- session ----------------------------------------------------------------------
+    @property
+    def session(self):
+        if self._session is None:
+            import onnxruntime as ort
+
+            opts = ort.SessionOptions()
+            if self.threads > 0:
+                opts.intra_op_num_threads = self.threads
+                opts.inter_op_num_threads = 1
+            try:
+                sess = ort.InferenceSession(self._data, sess_options=opts, providers=["CPUExecutionProvider"])
+            except Exception as e:  # onnxruntime raises its own untyped errors for bad files
+                raise WallcliError(f"cannot load model {self.path}: {str(e).splitlines()[0]}") from None
+            self._check_session(sess)
+            self._session = sess
+        return self._session
+
+    def _check_session(self, sess) -> None:
+        """The card must describe the graph: same input names, ranks and fixed sizes."""
+        got = {i.name: i.shape for i in sess.get_inputs()}
+        if sorted(got) != sorted(self.input_names):
+            raise WallcliError(f"model {self.path} has inputs {sorted(got)}, its card lists {self.input_names}",
+                               hint="wrong card for this model")
+        for spec in self.card["inputs"]:
+            shape = got[spec["name"]]
+            want = spec["shape"]
+            if len(shape) != len(want) or any(
+                    isinstance(s, int) and w is not None and s != w for s, w in zip(shape, want)):
+                raise WallcliError(f"model {self.path} input {spec['name']!r} has shape {shape}, card says {want}",
+                                   hint="wrong card for this model")
+        outs = sess.get_outputs()
+        if outs[0].name != OUTPUT_NAME:
+            raise WallcliError(f"model {self.path} output is {outs[0].name!r}, expected {OUTPUT_NAME!r}")
+
+    def predict(self, inputs: dict[str, np.ndarray], batch: int = 32) -> np.ndarray:
+        """Class probabilities (N, classes), float64, for normalised windows (N, 3, bins, window)."""
+        n = None
+        for spec in self.card["inputs"]:
+            name = spec["name"]
+            if name not in inputs:
+                raise WallcliError(f"model {self.path} needs input {name!r}")
+            x = inputs[name]
+            want = (3, self.bins, self.window)
+            if x.ndim != 4 or tuple(x.shape[1:]) != want:
+                raise WallcliError(
+                    f"input {name!r} has shape {tuple(x.shape)}, the model expects (N, {', '.join(map(str, want))})"
+                    " (batch, colour, space bins, time frames)",
+                    hint=f"space-time plots must have {self.bins} bins; windows are {self.window} frames")
+            if n is None:
+                n = x.shape[0]
+            elif x.shape[0] != n:
+                raise WallcliError("inputs have different numbers of windows")
+        sess = self.session
+        out = []
+        for i in range(0, n or 0, batch):
+            feed = {k: np.ascontiguousarray(inputs[k][i:i + batch], dtype=np.float32) for k in self.input_names}
+            out.append(sess.run([OUTPUT_NAME], feed)[0].astype(np.float64))
+        if not out:
+            return np.zeros((0, len(self.classes)))
+        return np.concatenate(out)
+
+
+def load_model(task: str, path: Path | str | None = None, *, threads: int = 0) -> Model:
+    """The user's model (``--model PATH``) or the shipped one for ``task``."""
+    if path is None:
+        p = shipped_model_path(task)
+        if not p.is_file():
+            raise WallcliError(f"the shipped {task} model is missing ({p})",
+                               hint="reinstall wallcli, or pass --model PATH to use your own")
+        return Model.load(p, task=task, threads=threads)
+    return Model.load(path, task=task, threads=threads)

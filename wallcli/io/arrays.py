@@ -1,0 +1,51 @@
+"""The ``.npz`` files wallcli writes: float arrays plus a JSON metadata string, never pickles."""
+
+from __future__ import annotations
+
+import json
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+from wallcli.io.writer import atomic_path
+
+META_KEY = "meta"
+
+
+def save_npz(path: str | os.PathLike, arrays: dict[str, np.ndarray], meta: dict, *, force: bool = False) -> None:
+    """Write ``arrays`` and ``meta`` (as a JSON unicode scalar) atomically."""
+    payload = {k: np.asarray(v) for k, v in arrays.items()}
+    for k, v in payload.items():
+        if v.dtype == object:
+            raise TypeError(f"array {k!r} has dtype object; it would need pickle")
+    payload[META_KEY] = np.array(json.dumps(meta))
+    with atomic_path(path, force=force) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **payload)
+
+
+def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[str, np.ndarray], dict]:
+    """Load a wallcli ``.npz``; ``kind`` checks ``meta['format']``. Corrupt files raise WallcliError."""
+    p = Path(path)
+    if not p.is_file():
+        raise WallcliError(f"no such file: {p}")
+    try:
+        with np.load(p, allow_pickle=False) as npz:
+            arrays = {k: npz[k] for k in npz.files}
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as exc:
+        raise WallcliError(f"{p} is not a readable .npz file ({type(exc).__name__}: {exc})") from exc
+    meta_arr = arrays.pop(META_KEY, None)
+    if meta_arr is None:
+        raise WallcliError(f"{p} has no wallcli metadata; was it written by wallcli?")
+    try:
+        meta = json.loads(str(meta_arr[()]))
+    except (json.JSONDecodeError, TypeError, IndexError) as exc:
+        raise WallcliError(f"{p} has corrupt metadata: {exc}") from exc
+    if not isinstance(meta, dict):
+        raise WallcliError(f"{p} has corrupt metadata (not a JSON object)")
+    if kind is not None and meta.get("format") != kind:
+        raise WallcliError(f"{p} is a {meta.get('format', 'unknown')!r} file, expected {kind!r}")
+    return arrays, meta

@@ -1,0 +1,345 @@
+"""One streaming video reader on PyAV: files, URLs, stdin ('-') and cameras.
+
+Frames come out as their decoded planes (Y, U, V at their native bit depth), never as rounded
+8-bit RGB: the wall signal is a fraction of a code value, and converting to rgb24 first would
+quantise it away. Block averages are taken on the planes and only then converted to RGB (the
+conversion is affine, so the mean commutes with it).
+
+Decoding runs in a background thread feeding a small queue (PyAV releases the GIL while it
+decodes), so decode and the per-frame arithmetic overlap on two cores; memory stays bounded by
+the queue, whatever the video's length.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import re
+import threading
+import warnings
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+
+# Luma coefficients (Kr, Kb) of the YUV matrices we honour.
+_MATRICES = {"bt601": (0.299, 0.114), "bt709": (0.2126, 0.0722), "bt2020": (0.2627, 0.0593)}
+# FFmpeg's AVColorSpace values -> our names (2 = unspecified, guessed from the frame height).
+_AVCOL_SPC = {1: "bt709", 4: "bt601", 5: "bt601", 6: "bt601", 7: "bt601", 9: "bt2020", 10: "bt2020"}
+_YUV_RE = re.compile(r"^yuv(j?)(420|422|444|440|411|410)p(\d+)?(le|be)?$")
+_GRAY_RE = re.compile(r"^gray(\d+)?(le|be)?$")
+_SUB = {"420": (1, 1), "422": (1, 0), "444": (0, 0), "440": (0, 1), "411": (2, 0), "410": (2, 1)}
+
+_QUEUE_SIZE = 8
+
+
+@dataclass
+class VideoInfo:
+    source: str
+    width: int
+    height: int
+    fps: Fraction
+    frame_count: int | None
+    pix_fmt: str
+    duration: float | None
+
+
+@dataclass
+class Planes:
+    """A decoded frame's planes in their native code values, and how to turn them into RGB.
+
+    ``kind`` is 'yuv' (y, u, v), 'gray' (y only) or 'rgb' (y, u, v hold R, G, B at full size).
+    """
+
+    y: np.ndarray
+    u: np.ndarray | None
+    v: np.ndarray | None
+    kind: str = "yuv"
+    sub_x: int = 0
+    sub_y: int = 0
+    depth: int = 8
+    matrix: str = "bt601"
+    full_range: bool = False
+
+    @property
+    def width(self) -> int:
+        return self.y.shape[1]
+
+    @property
+    def height(self) -> int:
+        return self.y.shape[0]
+
+    def to_rgb(self, y, u=None, v=None) -> np.ndarray:
+        """Affine map of plane values (any equal shapes, float) to RGB on the 0-255 scale, unclipped.
+
+        Clipping would bias averages of values near black or white, so out-of-gamut stays as is.
+        """
+        scale = float(1 << (self.depth - 8))
+        y = np.asarray(y, dtype=np.float64) / scale
+        if self.kind == "rgb":
+            return np.stack([y, np.asarray(u) / scale, np.asarray(v) / scale], axis=-1).astype(np.float32)
+        if self.kind == "gray" or u is None:
+            yy = y if self.full_range else (y - 16.0) * (255.0 / 219.0)
+            return np.repeat(yy[..., None], 3, axis=-1).astype(np.float32)
+        u = np.asarray(u, dtype=np.float64) / scale - 128.0
+        v = np.asarray(v, dtype=np.float64) / scale - 128.0
+        if self.full_range:
+            yy, cb, cr = y, u, v
+        else:
+            yy, cb, cr = (y - 16.0) * (255.0 / 219.0), u * (255.0 / 224.0), v * (255.0 / 224.0)
+        kr, kb = _MATRICES[self.matrix]
+        kg = 1.0 - kr - kb
+        r = yy + 2.0 * (1.0 - kr) * cr
+        b = yy + 2.0 * (1.0 - kb) * cb
+        g = (yy - kr * r - kb * b) / kg
+        return np.stack([r, g, b], axis=-1).astype(np.float32)
+
+    def rgb(self) -> np.ndarray:
+        """The whole frame as float32 RGB (H, W, 3), chroma upsampled bilinearly, no rounding."""
+        import cv2
+
+        if self.kind != "yuv":
+            return self.to_rgb(self.y, self.u, self.v)
+        h, w = self.y.shape
+        u = self.u.astype(np.float32)
+        v = self.v.astype(np.float32)
+        if u.shape != (h, w):
+            u = cv2.resize(u, (w, h), interpolation=cv2.INTER_LINEAR)
+            v = cv2.resize(v, (w, h), interpolation=cv2.INTER_LINEAR)
+        return self.to_rgb(self.y, u, v)
+
+
+@dataclass
+class Frame:
+    index: int
+    time: float
+    planes: Planes
+    _keep: object = field(default=None, repr=False)  # the av.VideoFrame whose buffers the planes view
+
+
+def _plane_array(plane, width: int, height: int, dtype) -> np.ndarray:
+    itemsize = np.dtype(dtype).itemsize
+    arr = np.frombuffer(plane, dtype=dtype)
+    return arr.reshape(-1, plane.line_size // itemsize)[:height, :width]
+
+
+def frame_planes(frame) -> Planes:
+    """The planes of a decoded ``av.VideoFrame``; exotic pixel formats are converted by swscale."""
+    name = frame.format.name
+    w, h = frame.width, frame.height
+    m = _YUV_RE.match(name)
+    g = _GRAY_RE.match(name)
+    if m is None and g is None and name not in ("rgb24", "bgr24", "gbrp"):
+        # Packed, semi-planar (nv12), paletted or hardware formats: convert once, at full depth.
+        deep = any(c.bits > 8 for c in frame.format.components)
+        frame = frame.reformat(format="yuv444p16le" if deep else "yuv444p")
+        return frame_planes(frame)
+    if name in ("rgb24", "bgr24"):
+        arr = _plane_array(frame.planes[0], w * 3, h, np.uint8).reshape(h, w, 3)
+        r, gg, b = (arr[..., 0], arr[..., 1], arr[..., 2]) if name == "rgb24" else (arr[..., 2], arr[..., 1], arr[..., 0])
+        return Planes(np.ascontiguousarray(r), np.ascontiguousarray(gg), np.ascontiguousarray(b), kind="rgb")
+    if name == "gbrp":
+        gp, bp, rp = (_plane_array(frame.planes[i], w, h, np.uint8) for i in range(3))
+        return Planes(rp, gp, bp, kind="rgb")
+    bits = int((m or g).group(3 if m else 1) or 8)
+    if (m or g).group(4 if m else 2) == "be":
+        frame = frame.reformat(format=name[:-2] + "le")
+    dtype = np.uint8 if bits <= 8 else np.uint16
+    y = _plane_array(frame.planes[0], w, h, dtype)
+    spc = _AVCOL_SPC.get(int(frame.colorspace or 2)) or ("bt709" if h >= 720 else "bt601")
+    full = int(frame.color_range or 0) == 2 or (m is not None and m.group(1) == "j")
+    if g is not None:
+        # Gray formats are full range in FFmpeg unless the stream says otherwise.
+        return Planes(y, None, None, kind="gray", depth=bits, matrix=spc, full_range=int(frame.color_range or 0) != 1)
+    sx, sy = _SUB[m.group(2)]
+    cw, ch = (w + (1 << sx) - 1) >> sx, (h + (1 << sy) - 1) >> sy  # ceil: odd sizes keep their last column
+    u = _plane_array(frame.planes[1], cw, ch, dtype)
+    v = _plane_array(frame.planes[2], cw, ch, dtype)
+    return Planes(y, u, v, kind="yuv", sub_x=sx, sub_y=sy, depth=bits, matrix=spc, full_range=full)
+
+
+def _describe_open_error(source: str, exc: Exception) -> WallcliError:
+    text = str(exc)
+    if isinstance(exc, FileNotFoundError) or "No such file" in text:
+        return WallcliError(f"no such file: {source}")
+    if "Permission denied" in text:
+        return WallcliError(f"cannot read {source}: permission denied")
+    return WallcliError(f"{source} is not a readable video (FFmpeg: {text.strip() or type(exc).__name__})")
+
+
+def _is_url(source: str) -> bool:
+    return re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*://", source) is not None
+
+
+class VideoReader:
+    """Open with :func:`open_video`; iterate :meth:`frames` once (decode once, stream)."""
+
+    def __init__(self, source: str, *, threads: int = 0, input_format: str | None = None):
+        import av
+
+        self.source = source
+        self.warnings: list[str] = []
+        options: dict[str, str] = {}
+        target = source
+        fmt = input_format
+        if source == "-":
+            target = "pipe:0"
+        elif _is_url(source):
+            if source.startswith("rtsp://"):
+                options["rtsp_transport"] = "tcp"
+            options.setdefault("rw_timeout", "15000000")
+        elif source.startswith("/dev/video"):
+            fmt = fmt or "v4l2"
+        else:
+            p = Path(source)
+            if not p.exists():
+                raise WallcliError(f"no such file: {source}")
+            if p.is_dir():
+                raise WallcliError(f"{source} is a folder, not a video")
+            if p.stat().st_size == 0:
+                raise WallcliError(f"{source} is empty (0 bytes)")
+        try:
+            self._container = av.open(target, mode="r", format=fmt, options=options, timeout=30.0)
+        except (av.error.FFmpegError, OSError, ValueError) as exc:
+            raise _describe_open_error(source, exc) from None
+        if not self._container.streams.video:
+            self._container.close()
+            raise WallcliError(f"{source} has no video stream")
+        stream = self._container.streams.video[0]
+        stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
+        stream.codec_context.thread_count = int(threads)
+        self._stream = stream
+        rate = stream.average_rate or stream.guessed_rate or stream.base_rate
+        if not rate or rate <= 0:
+            rate = Fraction(30)
+            self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
+        fps = Fraction(rate).limit_denominator(1001)
+        count = int(stream.frames or 0) or None
+        duration = None
+        if stream.duration and stream.time_base:
+            duration = float(stream.duration * stream.time_base)
+        elif self._container.duration:
+            duration = self._container.duration / 1_000_000
+        if count is None and duration:
+            count = int(round(duration * float(fps))) or None
+        cc = stream.codec_context
+        self.info = VideoInfo(
+            source=source,
+            width=int(cc.width or stream.width or 0),
+            height=int(cc.height or stream.height or 0),
+            fps=fps,
+            frame_count=count,
+            pix_fmt=str(cc.pix_fmt or ""),
+            duration=duration,
+        )
+        self._used = False
+
+    # -- decoding -------------------------------------------------------------------------------
+    def _decode_into(self, q: "queue.Queue", stop: threading.Event) -> None:
+        import av
+
+        corrupt = 0
+        try:
+            for packet in self._container.demux(self._stream):
+                if stop.is_set():
+                    break
+                try:
+                    decoded = packet.decode()
+                except av.error.InvalidDataError:
+                    corrupt += 1
+                    continue
+                for frame in decoded:
+                    if frame.is_corrupt:
+                        corrupt += 1
+                    q.put(("frame", frame))
+                    if stop.is_set():
+                        break
+        except av.error.EOFError:
+            pass
+        except (av.error.FFmpegError, OSError) as exc:
+            q.put(("damage", str(exc).strip() or type(exc).__name__))
+        except BaseException as exc:  # noqa: BLE001 - handed to the consumer thread
+            q.put(("error", exc))
+        finally:
+            q.put(("end", corrupt))
+
+    def frames(self) -> Iterator[Frame]:
+        if self._used:
+            raise RuntimeError("a VideoReader is read once (decode once); open the video again")
+        self._used = True
+        q: queue.Queue = queue.Queue(maxsize=_QUEUE_SIZE)
+        stop = threading.Event()
+        worker = threading.Thread(target=self._decode_into, args=(q, stop), daemon=True, name="wallcli-decode")
+        worker.start()
+        index = 0
+        first_pts = None
+        last_time = -np.inf
+        tb = self._stream.time_base
+        fps = float(self.info.fps)
+        try:
+            while True:
+                kind, item = q.get()
+                if kind == "frame":
+                    frame = item
+                    if frame.pts is not None and tb is not None:
+                        if first_pts is None:
+                            first_pts = frame.pts
+                        t = float((frame.pts - first_pts) * tb)
+                    else:
+                        t = index / fps
+                    if t <= last_time:
+                        # Duplicate or out-of-order timestamps (broken muxers): keep time monotonic.
+                        t = last_time + 1.0 / fps
+                    last_time = t
+                    yield Frame(index, t, frame_planes(frame), frame)
+                    index += 1
+                elif kind == "damage":
+                    self._warn(f"{self.source}: the stream is damaged after frame {index} ({item}); "
+                               "using the frames before the damage")
+                elif kind == "error":
+                    raise item
+                else:
+                    if item:
+                        self._warn(f"{self.source}: skipped {item} corrupt packet(s)/frame(s)")
+                    expected = self.info.frame_count
+                    if index and expected and self.source != "-" and index < 0.9 * expected - 1:
+                        self._warn(f"{self.source}: decoded {index} of {expected} frames; "
+                                   "the file looks truncated")
+                    break
+        finally:
+            stop.set()
+            while worker.is_alive():
+                try:  # unblock the producer if it waits on a full queue
+                    q.get_nowait()
+                except queue.Empty:
+                    worker.join(timeout=0.05)
+        if index == 0:
+            raise WallcliError(f"{self.source}: no frames could be decoded")
+
+    def _warn(self, message: str) -> None:
+        self.warnings.append(message)
+        warnings.warn(message, VideoWarning, stacklevel=2)
+
+    def close(self) -> None:
+        if self._container is not None:
+            self._container.close()
+            self._container = None
+
+    def __enter__(self) -> "VideoReader":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class VideoWarning(UserWarning):
+    """Recoverable trouble in a video (corrupt packets, truncation); the CLI prints these once."""
+
+
+def open_video(source: str | os.PathLike, *, threads: int = 0, input_format: str | None = None) -> VideoReader:
+    """Open a path, an http(s)/rtsp URL, '-' (a streamable container on stdin) or /dev/videoN."""
+    return VideoReader(str(source), threads=threads, input_format=input_format)

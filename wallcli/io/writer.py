@@ -1,0 +1,141 @@
+"""Writing files safely: outputs appear whole or not at all, inputs are never touched."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from contextlib import contextmanager
+from fractions import Fraction
+from pathlib import Path
+from typing import Iterable, Iterator
+
+from wallcli.errors import WallcliError
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and os.path.samefile(a, b))
+    except OSError:
+        return False
+
+
+def check_output(path: str | os.PathLike, *, force: bool = False, inputs: Iterable = ()) -> Path:
+    """Validate an output path before any work starts, so a long job never fails at the end."""
+    out = Path(path)
+    if str(path) in ("", "-"):
+        raise WallcliError("this output must be a file path, not '-'")
+    for src in inputs:
+        if src is not None and str(src) != "-" and _same_file(out, Path(str(src))):
+            raise WallcliError(f"output {out} is the input; wallcli never overwrites an input")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise WallcliError(f"output folder does not exist: {parent}")
+    if out.is_dir():
+        raise WallcliError(f"output is a folder: {out}")
+    if out.exists() and not force:
+        raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
+    if not os.access(parent, os.W_OK):
+        raise WallcliError(f"output folder is not writable: {parent}")
+    return out
+
+
+@contextmanager
+def atomic_path(path: str | os.PathLike, *, force: bool = False) -> Iterator[Path]:
+    """Yield a temporary path beside ``path`` (same suffix, so muxers pick the right format).
+
+    On success it is fsynced and renamed over ``path``; on any exception (Ctrl-C included) it is
+    removed, so a crash never leaves a half-written output.
+    """
+    out = Path(path)
+    check_output(out, force=force)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=f".tmp{out.suffix}", dir=out.parent or ".")
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        if out.exists() and not force:  # someone else created it while we worked
+            raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
+        os.replace(tmp, out)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def write_text_atomic(path: str | os.PathLike, text: str, *, force: bool = False) -> None:
+    with atomic_path(path, force=force) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+class VideoWriter:
+    """Encode RGB uint8 frames with PyAV.
+
+    ``.mp4``/``.mov`` -> H.264 (``crf``), ``.mkv`` with ``codec='ffv1'`` -> lossless FFV1,
+    ``.y4m`` -> raw yuv. The caller owns atomicity (write to ``atomic_path``'s temp path).
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        fps: Fraction | float,
+        width: int,
+        height: int,
+        *,
+        codec: str | None = None,
+        crf: int = 18,
+        pix_fmt: str | None = None,
+        preset: str = "medium",
+    ):
+        import av
+
+        path = Path(path)
+        suffix = path.suffix.lower()
+        fps = Fraction(fps).limit_denominator(1001) if not isinstance(fps, Fraction) else fps
+        if suffix == ".y4m":
+            codec, pix_fmt = "rawvideo", pix_fmt or "yuv444p"
+            fmt = "yuv4mpegpipe"
+        else:
+            fmt = None
+            codec = codec or "libx264"
+        self._container = av.open(str(path), mode="w", format=fmt)
+        stream = self._container.add_stream(codec, rate=fps)
+        if codec in ("libx264", "h264"):
+            # x264 needs even sizes for 4:2:0; callers pass even sizes, we refuse silently odd ones.
+            pix_fmt = pix_fmt or "yuv420p"
+            stream.options = {"crf": str(crf), "preset": preset}
+        elif codec == "ffv1":
+            pix_fmt = pix_fmt or "gbrp"  # planar RGB: truly lossless for rgb24 input
+        stream.width, stream.height = int(width), int(height)
+        stream.pix_fmt = pix_fmt or "yuv420p"
+        if stream.pix_fmt.startswith("yuv"):
+            # swscale converts rgb24 with the BT.601 limited-range matrix; say so in the stream,
+            # or readers guess BT.709 for HD sizes and shift the colours.
+            stream.codec_context.colorspace = 6
+            stream.codec_context.color_range = 1
+        self._stream = stream
+        self._av = av
+        self.frames = 0
+
+    def write(self, rgb) -> None:
+        frame = self._av.VideoFrame.from_ndarray(rgb, format="rgb24")
+        frame.pts = None
+        for packet in self._stream.encode(frame):
+            self._container.mux(packet)
+        self.frames += 1
+
+    def close(self) -> None:
+        if self._container is None:
+            return
+        try:
+            for packet in self._stream.encode():
+                self._container.mux(packet)
+        finally:
+            self._container.close()
+            self._container = None
+
+    def __enter__(self) -> "VideoWriter":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

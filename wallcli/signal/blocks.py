@@ -1,0 +1,91 @@
+"""Precise block averaging of image planes.
+
+Sums are exact integers (OpenCV's integral image, int32 for 8-bit planes, float64 otherwise), so
+a wall signal of a fraction of a code value survives averaging; a uint8 resize would round it
+away. Block edges may be fractional: the integral image of box-shaped pixels is exactly bilinear
+inside each pixel, so interpolating it gives exact area averages for any number of bins, even
+bins smaller than a pixel (as with 4:2:0 chroma of a small ROI).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+
+Roi = tuple[int, int, int, int]
+
+
+def check_roi(roi: Roi | None, width: int, height: int) -> Roi:
+    """Full frame when ``roi`` is None; otherwise it must lie inside the frame and be non-empty."""
+    if roi is None:
+        return (0, 0, int(width), int(height))
+    x, y, w, h = (int(v) for v in roi)
+    if w <= 0 or h <= 0:
+        raise WallcliError(f"ROI {x},{y},{w},{h} is empty; the frame is {width}x{height}")
+    if x < 0 or y < 0 or x + w > width or y + h > height:
+        raise WallcliError(f"ROI {x},{y},{w},{h} is outside the {width}x{height} frame "
+                           f"(x+w must be <= {width}, y+h <= {height})")
+    return (x, y, w, h)
+
+
+def bin_edges(start: float, stop: float, bins: int) -> np.ndarray:
+    """``bins`` equal-width (possibly fractional) edges spanning [start, stop]."""
+    return np.linspace(float(start), float(stop), int(bins) + 1)
+
+
+def _interp_integral(integral: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Bilinear interpolation of an integral image at fractional (rows x cols) positions."""
+    h1, w1 = integral.shape
+    r0 = np.clip(np.floor(rows).astype(np.intp), 0, h1 - 2)
+    c0 = np.clip(np.floor(cols).astype(np.intp), 0, w1 - 2)
+    fr = (rows - r0)[:, None]
+    fc = (cols - c0)[None, :]
+    a = integral[np.ix_(r0, c0)].astype(np.float64)
+    b = integral[np.ix_(r0, c0 + 1)].astype(np.float64)
+    c = integral[np.ix_(r0 + 1, c0)].astype(np.float64)
+    d = integral[np.ix_(r0 + 1, c0 + 1)].astype(np.float64)
+    return a * (1 - fr) * (1 - fc) + b * (1 - fr) * fc + c * fr * (1 - fc) + d * fr * fc
+
+
+def integral_image(plane: np.ndarray) -> np.ndarray:
+    import cv2
+
+    if plane.dtype == np.uint8 and plane.size * 255 < 2**31:
+        return cv2.integral(plane, sdepth=cv2.CV_32S)
+    return cv2.integral(np.ascontiguousarray(plane) if plane.dtype != np.uint8 else plane, sdepth=cv2.CV_64F)
+
+
+def block_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.ndarray) -> np.ndarray:
+    """Exact area means of ``plane`` over the grid of (possibly fractional) edges, float64.
+
+    Edges are in the plane's pixel coordinates; only the spanned rectangle is integrated.
+    """
+    r_lo, r_hi = int(np.floor(row_edges[0])), int(np.ceil(row_edges[-1]))
+    c_lo, c_hi = int(np.floor(col_edges[0])), int(np.ceil(col_edges[-1]))
+    sub = plane[r_lo:r_hi, c_lo:c_hi]
+    integ = integral_image(sub)
+    j = _interp_integral(integ, np.asarray(row_edges, np.float64) - r_lo, np.asarray(col_edges, np.float64) - c_lo)
+    sums = j[1:, 1:] - j[:-1, 1:] - j[1:, :-1] + j[:-1, :-1]
+    area = np.diff(row_edges)[:, None] * np.diff(col_edges)[None, :]
+    return sums / area
+
+
+def rgb_grid(planes, roi: Roi, bins_y: int, bins_x: int) -> np.ndarray:
+    """RGB means (0-255 scale, float64) of a ``bins_y`` x ``bins_x`` grid of equal blocks over ``roi``.
+
+    Averages are taken on the decoded planes and converted to RGB afterwards: the YUV->RGB map is
+    affine, so this equals converting every pixel first, at a fraction of the cost.
+    """
+    x, y, w, h = roi
+    rows = bin_edges(y, y + h, bins_y)
+    cols = bin_edges(x, x + w, bins_x)
+    ym = block_means(planes.y, rows, cols)
+    if planes.u is None:
+        return planes.to_rgb(ym).astype(np.float64)
+    # Chroma pixel k covers luma [k*2^s, (k+1)*2^s): scale the same edges down.
+    crow = rows / (1 << planes.sub_y)
+    ccol = cols / (1 << planes.sub_x)
+    um = block_means(planes.u, crow, ccol)
+    vm = block_means(planes.v, crow, ccol)
+    return planes.to_rgb(ym, um, vm).astype(np.float64)

@@ -1,0 +1,194 @@
+"""Space-time plots (seed notes §1): the wall averaged over rows (horizontal plot) or columns
+(vertical plot), one line per frame, each pixel's temporal mean removed.
+
+Layout: ``horizontal`` and ``vertical`` are float32 arrays (bins, T, 3) = position x time x RGB,
+in 8-bit code values. Horizontal position runs left to right, vertical position top to bottom.
+Both plots come from one bins x bins grid of exact block means, so they are consistent.
+Mean removal commutes with spatial averaging (both are linear), so removing the mean from the
+small plot equals removing it from every pixel first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Iterable
+
+import numpy as np
+
+from wallcli import __version__
+from wallcli.signal.blocks import Roi, check_roi, rgb_grid
+from wallcli.signal.mean import MODES, remove_mean
+
+FORMAT = "wallcli.stplot"
+FORMAT_VERSION = 1
+MIN_FRAMES = 2
+
+
+@dataclass
+class StPlot:
+    horizontal: np.ndarray  # (bins, T, 3) float32, mean removed
+    vertical: np.ndarray  # (bins, T, 3) float32, mean removed
+    time: np.ndarray  # (T,) float64 seconds from the first frame
+    h_mean: np.ndarray  # (bins, 3) float32: the clip mean of the raw levels (what was removed, for 'clip')
+    v_mean: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def frames(self) -> int:
+        return int(self.time.shape[0])
+
+    @property
+    def bins(self) -> int:
+        return int(self.horizontal.shape[0])
+
+
+class RowReducer:
+    """Per frame: the raw (not mean-removed) horizontal and vertical rows, float64 (bins, 3)."""
+
+    def __init__(self, roi: Roi, bins: int = 64):
+        self.roi, self.bins = roi, int(bins)
+
+    def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
+        grid = rgb_grid(planes, self.roi, self.bins, self.bins)
+        # Equal-area blocks: the mean over rows of block means is the mean over the ROI's rows.
+        return grid.mean(axis=0), grid.mean(axis=1)
+
+
+class _Growing:
+    """An append-only float32 array that doubles its capacity (no list of small arrays)."""
+
+    def __init__(self, shape: tuple[int, ...], dtype=np.float32):
+        self._a = np.empty((256, *shape), dtype)
+        self.n = 0
+
+    def append(self, row) -> None:
+        if self.n == self._a.shape[0]:
+            self._a = np.concatenate([self._a, np.empty_like(self._a)])
+        self._a[self.n] = row
+        self.n += 1
+
+    def array(self) -> np.ndarray:
+        return self._a[: self.n]
+
+
+def _finish(h_raw, v_raw, times, meta, mean: str, mean_seconds: float) -> StPlot:
+    h_raw = h_raw.astype(np.float64)
+    v_raw = v_raw.astype(np.float64)
+    h = remove_mean(h_raw, times, mean, mean_seconds)
+    v = remove_mean(v_raw, times, mean, mean_seconds)
+    return StPlot(
+        horizontal=np.ascontiguousarray(h.transpose(1, 0, 2)),
+        vertical=np.ascontiguousarray(v.transpose(1, 0, 2)),
+        time=np.asarray(times, np.float64),
+        h_mean=h_raw.mean(axis=0).astype(np.float32),
+        v_mean=v_raw.mean(axis=0).astype(np.float32),
+        meta=meta,
+    )
+
+
+def compute_stplot(
+    reader,
+    *,
+    roi: Roi | None = None,
+    bins: int = 64,
+    mean: str = "clip",
+    mean_seconds: float = 10.0,
+    progress: Callable[[int], None] | None = None,
+) -> StPlot:
+    """Stream ``reader`` (a :class:`wallcli.io.video.VideoReader`) once into space-time plots."""
+    from wallcli.errors import WallcliError
+
+    if mean not in MODES:
+        raise ValueError(f"mean must be one of {MODES}")
+    info = reader.info
+    roi = check_roi(roi, info.width, info.height)
+    reduce = RowReducer(roi, bins)
+    h_rows, v_rows, times = _Growing((bins, 3)), _Growing((bins, 3)), _Growing((), np.float64)
+    for frame in reader.frames():
+        if frame.index == 0 and (frame.planes.width, frame.planes.height) != (info.width, info.height):
+            roi = check_roi(roi, frame.planes.width, frame.planes.height)
+        h, v = reduce(frame.planes)
+        h_rows.append(h)
+        v_rows.append(v)
+        times.append(frame.time)
+        if progress:
+            progress(1)
+    if times.n < MIN_FRAMES:
+        raise WallcliError(f"{info.source} has {times.n} frame(s); a space-time plot needs at least "
+                           f"{MIN_FRAMES} (the temporal mean of one frame is the frame itself)")
+    meta = {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "source": str(info.source),
+        "frame_size": [info.width, info.height],
+        "fps": float(info.fps),
+        "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}",
+        "frames": times.n,
+        "roi": list(roi),
+        "bins": int(bins),
+        "mean": mean,
+        "mean_seconds": float(mean_seconds) if mean != "clip" else None,
+        "units": "8-bit code values (0-255 scale), mean removed",
+        "layout": "position x time x channel; horizontal: left->right, vertical: top->bottom",
+        "channels": ["r", "g", "b"],
+        "wallcli_version": __version__,
+        "warnings": list(getattr(reader, "warnings", [])),
+    }
+    return _finish(h_rows.array(), v_rows.array(), times.array(), meta, mean, mean_seconds)
+
+
+def stplot_from_rgb_frames(
+    frames: Iterable[np.ndarray], times: Iterable[float], *, roi: Roi | None = None, bins: int = 64,
+    mean: str = "clip", mean_seconds: float = 10.0,
+) -> StPlot:
+    """The same plots from float RGB arrays (H, W, 3) already in memory (simulations, tests)."""
+    from types import SimpleNamespace
+
+    h_rows, v_rows, ts = [], [], []
+    reduce = None
+    for rgb, t in zip(frames, times):
+        rgb = np.asarray(rgb)
+        planes = SimpleNamespace(
+            y=rgb[..., 0], u=rgb[..., 1], v=rgb[..., 2], sub_x=0, sub_y=0,
+            to_rgb=lambda r, g, b: np.stack([r, g, b], axis=-1),
+        )
+        if reduce is None:
+            reduce = RowReducer(check_roi(roi, rgb.shape[1], rgb.shape[0]), bins)
+        h, v = reduce(planes)
+        h_rows.append(h)
+        v_rows.append(v)
+        ts.append(float(t))
+    meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "source": "<arrays>", "bins": int(bins),
+            "mean": mean, "frames": len(ts), "roi": list(reduce.roi) if reduce else None,
+            "wallcli_version": __version__}
+    if len(ts) >= 2:
+        meta["fps"] = float((len(ts) - 1) / (ts[-1] - ts[0])) if ts[-1] > ts[0] else None
+    return _finish(np.asarray(h_rows), np.asarray(v_rows), np.asarray(ts), meta, mean, mean_seconds)
+
+
+def to_arrays(plot: StPlot) -> tuple[dict[str, np.ndarray], dict]:
+    """The ``.npz`` payload of a plot: ``save_npz(path, *to_arrays(plot))``."""
+    return ({"horizontal": plot.horizontal, "vertical": plot.vertical, "time": plot.time,
+             "h_mean": plot.h_mean, "v_mean": plot.v_mean}, plot.meta)
+
+
+def from_arrays(arrays: dict[str, np.ndarray], meta: dict, source: str = "file") -> StPlot:
+    """Validate a loaded ``.npz`` payload: ``from_arrays(*load_npz(path, kind=FORMAT))``."""
+    from wallcli.errors import WallcliError
+
+    try:
+        h = np.asarray(arrays["horizontal"], np.float32)
+        v = np.asarray(arrays["vertical"], np.float32)
+        t = np.asarray(arrays["time"], np.float64)
+        hm = np.asarray(arrays.get("h_mean", np.zeros((h.shape[0], 3))), np.float32)
+        vm = np.asarray(arrays.get("v_mean", np.zeros((v.shape[0], 3))), np.float32)
+    except KeyError as exc:
+        raise WallcliError(f"{source} is not a complete space-time plot (missing {exc.args[0]!r})") from None
+    if h.ndim != 3 or v.ndim != 3 or h.shape[2] != 3 or v.shape[1:] != h.shape[1:] or t.shape != (h.shape[1],):
+        raise WallcliError(f"{source} has inconsistent space-time plot shapes "
+                           f"(horizontal {h.shape}, vertical {v.shape}, time {t.shape})")
+    if not (np.all(np.isfinite(h)) and np.all(np.isfinite(v)) and np.all(np.isfinite(t))):
+        raise WallcliError(f"{source} contains non-finite values")
+    if t.size > 1 and np.any(np.diff(t) <= 0):
+        raise WallcliError(f"{source} has timestamps that do not increase")
+    return StPlot(h, v, t, hm, vm, dict(meta))

@@ -1,0 +1,109 @@
+"""What the networks see: 256-sample windows of space-time plots at a canonical 30 fps.
+
+Training (simulated clips) and inference (any video) both go through these functions, so the
+model sees at run time exactly what it saw in training.
+
+Decisions (seed notes are silent on them):
+- Canonical rate 30 fps: 256 samples = 8.533 s. Other rates are resampled by linear
+  interpolation on the frames' own timestamps (which also regularises variable frame rates).
+  Any clip of >= 8.6 s therefore gives a window, whatever its frame rate.
+- ``normalize_window`` (version 1): remove each (position, colour) mean over the window, then
+  divide by the window's RMS over everything. Signals span orders of magnitude (distance^-4,
+  light level, exposure); dividing by the RMS makes the input scale-free while keeping the
+  relative strength of colours and positions.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import Iterator
+
+import numpy as np
+
+CANONICAL_FPS = 30.0
+WINDOW = 256
+BINS = 64
+DEFAULT_STRIDE = 64
+NORMALIZATION = "wallcli.signal.window.normalize_window v1"
+
+
+def resample(plot: np.ndarray, time: np.ndarray, fps: float = CANONICAL_FPS) -> tuple[np.ndarray, np.ndarray]:
+    """Resample (bins, T, C) plot with timestamps ``time`` onto a uniform ``fps`` grid from time[0]."""
+    plot = np.asarray(plot, np.float32)
+    time = np.asarray(time, np.float64)
+    if time.size < 2:
+        return plot.copy(), time.copy()
+    n = int(np.floor((time[-1] - time[0]) * fps + 1e-6)) + 1
+    grid = time[0] + np.arange(n) / fps
+    idx = np.clip(np.searchsorted(time, grid, side="right") - 1, 0, time.size - 2)
+    w = ((grid - time[idx]) / (time[idx + 1] - time[idx])).astype(np.float32)
+    w = np.clip(w, 0.0, 1.0)[None, :, None]
+    out = plot[:, idx] * (1 - w) + plot[:, idx + 1] * w
+    return out.astype(np.float32), grid
+
+
+def window_starts(length: int, window: int = WINDOW, stride: int = DEFAULT_STRIDE) -> list[int]:
+    """Start indices of every full window; the last one is aligned to the end so no tail is lost."""
+    if length < window:
+        return []
+    starts = list(range(0, length - window + 1, max(1, int(stride))))
+    if starts[-1] != length - window:
+        starts.append(length - window)
+    return starts
+
+
+def normalize_window(x: np.ndarray) -> np.ndarray:
+    """(..., bins, WINDOW, 3) plot windows -> float32 (..., 3, bins, WINDOW) network input."""
+    x = np.asarray(x, np.float32)
+    x = x - x.mean(axis=-2, keepdims=True)
+    rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=(-3, -2, -1), keepdims=True)).astype(np.float32)
+    x = x / np.maximum(rms, 1e-8)
+    return np.ascontiguousarray(np.moveaxis(x, -1, -3))
+
+
+class StreamResampler:
+    """Online version of :func:`resample` for live input: push timestamped rows, get 30 fps rows."""
+
+    def __init__(self, fps: float = CANONICAL_FPS):
+        self.fps = float(fps)
+        self._prev = None  # (t, row)
+        self._next_t = None
+
+    def push(self, t: float, row: np.ndarray) -> Iterator[tuple[float, np.ndarray]]:
+        row = np.asarray(row, np.float32)
+        if self._prev is None:
+            self._prev = (t, row)
+            self._next_t = t
+            yield t, row
+            self._next_t = t + 1.0 / self.fps
+            return
+        t0, r0 = self._prev
+        if t <= t0:
+            return
+        while self._next_t <= t + 1e-9:
+            w = np.float32((self._next_t - t0) / (t - t0))
+            yield self._next_t, r0 * (1 - w) + row * w
+            self._next_t += 1.0 / self.fps
+        self._prev = (t, row)
+
+
+class StreamWindower:
+    """Collect resampled rows; emit (start_time, end_time, window (bins, WINDOW, C)) every ``stride``."""
+
+    def __init__(self, window: int = WINDOW, stride: int = DEFAULT_STRIDE):
+        self.window, self.stride = int(window), max(1, int(stride))
+        self._rows: deque = deque(maxlen=self.window)
+        self._times: deque = deque(maxlen=self.window)
+        self._since = 0
+        self._count = 0
+
+    def push(self, t: float, row: np.ndarray):
+        """Add one (bins, C) row at time ``t``; returns a window tuple when one completes, else None."""
+        self._rows.append(np.asarray(row, np.float32))
+        self._times.append(float(t))
+        self._count += 1
+        self._since += 1
+        if self._count >= self.window and (self._count == self.window or self._since >= self.stride):
+            self._since = 0
+            return self._times[0], self._times[-1], np.stack(self._rows, axis=1)
+        return None

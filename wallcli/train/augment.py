@@ -1,0 +1,64 @@
+"""Training-time augmentation of raw windows, before ``normalize_window``.
+
+Each transform is something a real recording can do to a space-time plot without changing
+its label, which is how a model trained on the simulator learns to ignore the room:
+
+- space mirror (p 0.5): the hidden scene seen left-right flipped.  Horizontal plot only:
+  mirroring the vertical plot would swap floor and ceiling, and crouching/jumping depend on it.
+- time reversal (p 0.5, all plots together): walking right-to-left is still walking; a crouch
+  reversed is standing up from a crouch, still the crouching activity; waving and jumping
+  are symmetric.
+- colour-channel permutation (p 0.5, same permutation for all plots): rooms and clothes of
+  any colour.
+- per-channel gain jitter (log-normal, sigma 0.25): white balance and light colour; a global
+  gain would be removed by the window normalisation anyway.
+- added white noise (p 0.5, std a log-uniform 2-50 % of the window's RMS): other cameras,
+  darker rooms, stronger compression.
+- slow illumination drift (p 0.3): a ramp common to all positions (daylight, auto exposure),
+  up to half the window's RMS.
+Augmentations draw from a generator seeded by (seed, epoch, batch), so resumed runs repeat them.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+DESCRIPTION = [
+    "space mirror, horizontal plot only (p=0.5)",
+    "time reversal, all plots together (p=0.5)",
+    "colour-channel permutation, same for all plots (p=0.5)",
+    "per-channel gain jitter, log-normal sigma 0.25",
+    "added white noise, std log-uniform 2-50% of window RMS (p=0.5)",
+    "slow illumination ramp common to all positions, up to 0.5x window RMS (p=0.3)",
+]
+
+
+def augment(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Generator) -> dict[str, np.ndarray]:
+    """Augment raw windows (B, bins, T, 3) per input name; returns new arrays, labels untouched."""
+    out = dict(batch)
+    first = batch[inputs[0]]
+    b, _, t, c = first.shape
+    mirror = rng.random(b) < 0.5
+    reverse = rng.random(b) < 0.5
+    permute = rng.random(b) < 0.5
+    perms = np.array([rng.permutation(c) if p else np.arange(c) for p in permute])
+    gains = np.exp(rng.normal(0.0, 0.25, size=(b, 1, 1, c))).astype(np.float32)
+    noisy = rng.random(b) < 0.5
+    noise_rel = np.exp(rng.uniform(np.log(0.02), np.log(0.5), size=b)) * noisy
+    drifting = rng.random(b) < 0.3
+    drift_rel = rng.uniform(-0.5, 0.5, size=b) * drifting
+    ramp = np.linspace(-1.0, 1.0, t, dtype=np.float32)
+    for name in inputs:
+        x = batch[name].astype(np.float32, copy=True)
+        if name == "horizontal":
+            x[mirror] = x[mirror, ::-1]
+        x[reverse] = x[reverse, :, ::-1]
+        x = np.take_along_axis(x, perms[:, None, None, :], axis=3)
+        x *= gains
+        # scale of the window's own variation (the per-bin mean is irrelevant after normalisation)
+        centred = x - x.mean(axis=2, keepdims=True)
+        rms = np.sqrt((centred.astype(np.float64) ** 2).mean(axis=(1, 2, 3))) + 1e-12
+        x += (rng.standard_normal(x.shape, dtype=np.float32)
+              * (noise_rel * rms).astype(np.float32)[:, None, None, None])
+        x += (drift_rel * rms).astype(np.float32)[:, None, None, None] * ramp[None, None, :, None]
+        out[name] = x
+    return out

@@ -1,0 +1,144 @@
+"""Training data: the simulator's shard datasets (``DIR/dataset.json`` + ``shard-NNNNN.npz``).
+
+Shards can be larger than memory in total, so an epoch is planned as a list of batches of
+global window indices: shards in a random order, grouped into chunks of at most
+``buffer_windows`` windows, windows shuffled within a chunk.  The plan depends only on
+(seed, epoch), which is what makes mid-epoch resume exact.  Shards are loaded on demand and
+kept in a small cache of two chunks (a batch can straddle a chunk boundary).
+"""
+from __future__ import annotations
+
+import json
+from collections import OrderedDict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+from wallcli.infer.card import TASK_CLASSES, TASK_INPUTS
+
+DATASET_FORMAT = "wallcli.dataset"
+SHARD_FORMAT = "wallcli.dataset-shard"
+
+
+class ShardDataset:
+    def __init__(self, root: Path | str, task: str, *, bins: int = 64, window: int = 256,
+                 buffer_windows: int = 4096) -> None:
+        self.root = Path(root)
+        man_path = self.root / "dataset.json"
+        if not man_path.is_file():
+            raise WallcliError(f"{self.root} is not a wallcli dataset (no dataset.json)",
+                               hint="create one with the simulator's dataset mode")
+        try:
+            man = json.loads(man_path.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as e:
+            raise WallcliError(f"{man_path} is not valid JSON: {e}") from None
+        if man.get("format") != DATASET_FORMAT or man.get("version") != 1:
+            raise WallcliError(f"{man_path}: not a {DATASET_FORMAT} v1 manifest")
+        if man.get("task") != task:
+            raise WallcliError(f"{self.root} is a {man.get('task')!r} dataset, training a {task!r} model needs a {task!r} one")
+        if list(man.get("classes", [])) != TASK_CLASSES[task]:
+            raise WallcliError(f"{man_path}: classes {man.get('classes')} differ from {TASK_CLASSES[task]}")
+        if man.get("window") != window or man.get("bins") != bins:
+            raise WallcliError(f"{man_path}: windows are {man.get('bins')} bins x {man.get('window')} frames, "
+                               f"the nets need {bins} x {window}")
+        self.manifest: dict[str, Any] = man
+        self.task = task
+        self.inputs = TASK_INPUTS[task]
+        self.classes = TASK_CLASSES[task]
+        self.shape = (bins, window, 3)
+        self.files = [self.root / s["file"] for s in man["shards"]]
+        self.sizes = np.array([int(s["n"]) for s in man["shards"]], dtype=np.int64)
+        self.offsets = np.concatenate([[0], np.cumsum(self.sizes)])
+        self.n = int(self.offsets[-1])
+        if self.n == 0:
+            raise WallcliError(f"{self.root} holds no windows")
+        self.buffer_windows = max(int(buffer_windows), 1)
+        self._cache: OrderedDict[int, dict[str, np.ndarray]] = OrderedDict()
+        self._cache_windows = 0
+
+    # -- shards -----------------------------------------------------------------------
+    def _load_shard(self, i: int) -> dict[str, np.ndarray]:
+        if i in self._cache:
+            self._cache.move_to_end(i)
+            return self._cache[i]
+        from wallcli.io.arrays import load_npz
+
+        arrays, _ = load_npz(self.files[i], kind=SHARD_FORMAT)
+        n = int(self.sizes[i])
+        out = {}
+        for name in (*self.inputs, "label"):
+            if name not in arrays:
+                raise WallcliError(f"{self.files[i]}: missing array {name!r}")
+            out[name] = arrays[name]
+        for name in self.inputs:
+            if out[name].shape != (n, *self.shape):
+                raise WallcliError(f"{self.files[i]}: {name!r} has shape {out[name].shape}, "
+                                   f"manifest says {(n, *self.shape)}")
+            out[name] = out[name].astype(np.float32, copy=False)
+        lab = out["label"].astype(np.int64)
+        if lab.shape != (n,) or lab.min(initial=0) < 0 or lab.max(initial=0) >= len(self.classes):
+            raise WallcliError(f"{self.files[i]}: labels must be {n} integers in 0..{len(self.classes) - 1}")
+        out["label"] = lab
+        self._cache[i] = out
+        self._cache_windows += n
+        # keep about two chunks: evict least recently used shards beyond that
+        while self._cache_windows > 2 * self.buffer_windows and len(self._cache) > 1:
+            _, old = self._cache.popitem(last=False)
+            self._cache_windows -= len(old["label"])
+        return out
+
+    def labels(self) -> np.ndarray:
+        """All labels (loads every shard once; used for class counts and stratification)."""
+        return np.concatenate([self._load_shard(i)["label"] for i in range(len(self.files))])
+
+    def gather(self, idx: np.ndarray) -> dict[str, np.ndarray]:
+        """Raw windows (len(idx), bins, window, 3) per input, plus 'label', in the order of idx."""
+        shard = np.searchsorted(self.offsets, idx, side="right") - 1
+        out = {name: np.empty((len(idx), *self.shape), np.float32) for name in self.inputs}
+        out["label"] = np.empty(len(idx), np.int64)
+        for s in np.unique(shard):
+            sel = np.nonzero(shard == s)[0]
+            local = idx[sel] - self.offsets[s]
+            arrs = self._load_shard(int(s))
+            for name in out:
+                out[name][sel] = arrs[name][local]
+        return out
+
+    # -- epochs -----------------------------------------------------------------------
+    def plan(self, indices: np.ndarray, batch_size: int, rng: np.random.Generator,
+             shuffle: bool = True) -> list[np.ndarray]:
+        """Batches of global indices (a subset ``indices`` of the dataset) for one epoch."""
+        indices = np.sort(np.asarray(indices, dtype=np.int64))
+        if not shuffle:
+            return [indices[i:i + batch_size] for i in range(0, len(indices), batch_size)]
+        shard = np.searchsorted(self.offsets, indices, side="right") - 1
+        order = rng.permutation(len(self.files))
+        chunks: list[np.ndarray] = []
+        cur: list[np.ndarray] = []
+        cur_n = 0
+        for s in order:
+            sel = indices[shard == s]
+            if cur and cur_n + len(sel) > self.buffer_windows:
+                chunks.append(np.concatenate(cur))
+                cur, cur_n = [], 0
+            cur.append(sel)
+            cur_n += len(sel)
+        if cur:
+            chunks.append(np.concatenate(cur))
+        flat = np.concatenate([rng.permutation(c) for c in chunks]) if chunks else indices
+        batches = [flat[i:i + batch_size] for i in range(0, len(flat), batch_size)]
+        # batch norm cannot train on a single window
+        if batches and len(batches[-1]) < 2:
+            batches.pop()
+        return batches
+
+
+def split_validation(n: int, fraction: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(train, validation) global indices: a seeded random ``fraction`` held out."""
+    rng = np.random.default_rng([seed, 0x5A11])
+    perm = rng.permutation(n)
+    k = int(round(n * fraction)) if fraction > 0 else 0
+    k = min(max(k, 1 if fraction > 0 and n > 1 else 0), n - 1)
+    return np.sort(perm[k:]), np.sort(perm[:k])

@@ -1,0 +1,104 @@
+"""Export a trained net to ONNX with its model card.
+
+The graph ends in softmax (output ``probabilities``), batch is a dynamic axis, opset 17.
+Before the files are published, onnxruntime's output on random inputs is compared with
+torch's (max abs difference <= 1e-4 or the export fails), and the card records the sha256
+of the exact bytes written.  Both files are written atomically, the card last renamed
+first, so a model never appears without its card.
+"""
+from __future__ import annotations
+
+import copy
+import datetime as _dt
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from wallcli.errors import WallcliError
+from wallcli.infer.card import (CARD_FORMAT, CARD_VERSION, OUTPUT_NAME, PREPROCESSING, card_path,
+                                input_spec, sha256_file, write_card)
+from wallcli.train.nets import BINS, WINDOW, WithSoftmax
+
+OPSET = 17
+PARITY_TOL = 1e-4
+DEFAULT_STRIDE = 64
+
+
+def export_onnx(net: torch.nn.Module, input_names: list[str], path: Path) -> None:
+    model = WithSoftmax(copy.deepcopy(net).to(memory_format=torch.contiguous_format)).eval()
+    dummy = tuple(torch.zeros(2, 3, BINS, WINDOW) for _ in input_names)
+    axes = {n: {0: "batch"} for n in [*input_names, OUTPUT_NAME]}
+    with warnings.catch_warnings():
+        # the TorchScript exporter is deprecated in favour of the dynamo one, which cannot
+        # yet trace our *inputs wrapper with a dynamic batch; it is exact for these ops
+        warnings.simplefilter("ignore")
+        torch.onnx.export(model, dummy, str(path), input_names=list(input_names), output_names=[OUTPUT_NAME],
+                          opset_version=OPSET, dynamic_axes=axes, dynamo=False)
+
+
+def check_parity(net: torch.nn.Module, input_names: list[str], path: Path, *, seed: int = 0,
+                 batches: tuple[int, ...] = (1, 5), tol: float = PARITY_TOL) -> float:
+    """Max |onnxruntime - torch| over random inputs of several batch sizes; raises above ``tol``."""
+    import onnxruntime as ort
+
+    model = WithSoftmax(net).eval()
+    sess = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    gen = torch.Generator().manual_seed(seed)
+    worst = 0.0
+    for n in batches:
+        xs = [torch.randn(n, 3, BINS, WINDOW, generator=gen) for _ in input_names]
+        with torch.no_grad():
+            ref = model(*xs).numpy()
+        got = sess.run([OUTPUT_NAME], {k: x.numpy() for k, x in zip(input_names, xs)})[0]
+        if got.shape != ref.shape:
+            raise WallcliError(f"exported model gives shape {got.shape}, torch {ref.shape}")
+        worst = max(worst, float(np.abs(got - ref).max()))
+    if worst > tol:
+        raise WallcliError(f"exported ONNX model differs from torch by {worst:.2e} (> {tol:.0e})")
+    return worst
+
+
+def build_card(*, name: str, version: str, task: str, classes: list[Any], input_names: list[str],
+               sha256: str, size_bytes: int, parameters: int, stride: int = DEFAULT_STRIDE,
+               training_data: dict[str, Any], training: dict[str, Any], validation: dict[str, Any] | None,
+               onnx_file: str, parity: float) -> dict[str, Any]:
+    from wallcli.signal.window import CANONICAL_FPS
+
+    return {
+        "format": CARD_FORMAT, "card_version": CARD_VERSION,
+        "name": name, "version": version, "task": task, "classes": list(classes),
+        "inputs": [input_spec(n, BINS, WINDOW) for n in input_names],
+        "output": {"name": OUTPUT_NAME, "shape": [None, len(classes)], "meaning": "class probabilities (softmax)"},
+        "preprocessing": PREPROCESSING,
+        "normalisation": "per (bin, colour) temporal mean over the window removed, then divided by the "
+                         "window's global RMS; channels first (N, 3, bins, time)",
+        "fps": CANONICAL_FPS, "window": WINDOW, "bins": BINS, "stride": stride,
+        "clip_aggregation": "mean of window probabilities",
+        "onnx": {"file": onnx_file, "opset": OPSET, "bytes": size_bytes, "parameters": parameters,
+                 "parity_max_abs_diff": parity, "torch": torch.__version__},
+        "sha256": sha256,
+        "training_data": training_data,
+        "training": training,
+        "validation": validation,
+        "created": _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat(),
+    }
+
+
+def export_model(net: torch.nn.Module, input_names: list[str], out: Path, card_fields: dict[str, Any], *,
+                 force: bool = False, seed: int = 0) -> dict[str, Any]:
+    """Write OUT (.onnx) and its card OUT.json; returns the card."""
+    from wallcli.io.writer import atomic_path
+
+    out = Path(out)
+    net = net.eval()
+    with atomic_path(out, force=force) as tmp_onnx, atomic_path(card_path(out), force=force) as tmp_card:
+        export_onnx(net, input_names, tmp_onnx)
+        parity = check_parity(net, input_names, tmp_onnx, seed=seed)
+        card = build_card(input_names=input_names, sha256=sha256_file(tmp_onnx), size_bytes=tmp_onnx.stat().st_size,
+                          parameters=sum(p.numel() for p in net.parameters()), onnx_file=out.name, parity=parity,
+                          **card_fields)
+        write_card(tmp_card, card)
+    return card
