@@ -49,7 +49,7 @@ def write_clip(
                 frame = av.VideoFrame.from_ndarray(np.clip(np.rint(img), 0, 255).astype(np.uint8), format="rgb24")
             if pts_fn is not None:
                 frame.pts = pts_fn(i)
-                frame.time_base = s.time_base
+                frame.time_base = time_base or Fraction(1, 1) / fps  # (reading s.time_base here gives pts 0)
             for p in s.encode(frame):
                 c.mux(p)
             if a is not None:

@@ -219,6 +219,7 @@ class VideoReader:
             self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
         fps = Fraction(rate).limit_denominator(1001)
         count = int(stream.frames or 0) or None
+        self._declared_frames = count  # exact where the container says (mp4); estimates are not
         duration = None
         if stream.duration and stream.time_base:
             duration = float(stream.duration * stream.time_base)
@@ -305,10 +306,7 @@ class VideoReader:
                 else:
                     if item:
                         self._warn(f"{self.source}: skipped {item} corrupt packet(s)/frame(s)")
-                    expected = self.info.frame_count
-                    if index and expected and self.source != "-" and index < 0.9 * expected - 1:
-                        self._warn(f"{self.source}: decoded {index} of {expected} frames; "
-                                   "the file looks truncated")
+                    self._check_complete(index, last_time)
                     break
         finally:
             stop.set()
@@ -319,6 +317,18 @@ class VideoReader:
                     worker.join(timeout=0.05)
         if index == 0:
             raise WallcliError(f"{self.source}: no frames could be decoded")
+
+    def _check_complete(self, decoded: int, last_time: float) -> None:
+        """Warn when the file promised more frames or more time than it held (truncation)."""
+        if not decoded or self.source == "-" or _is_url(self.source):
+            return
+        expected = self._declared_frames
+        duration = self.info.duration
+        if expected and decoded < 0.9 * expected - 1:
+            self._warn(f"{self.source}: decoded {decoded} of {expected} frames; the file looks truncated")
+        elif duration and last_time + 2.0 / float(self.info.fps) < 0.9 * duration:
+            self._warn(f"{self.source}: frames end at {last_time:.2f} s of {duration:.2f} s; "
+                       "the file looks truncated")
 
     def _warn(self, message: str) -> None:
         self.warnings.append(message)

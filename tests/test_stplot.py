@@ -1,0 +1,71 @@
+"""`wallcli stplot`: the .npz format, the PNG, the mean modes."""
+
+import json
+
+import numpy as np
+import pytest
+
+from clips import write_clip
+from wallcli.signal.mean import remove_mean
+
+
+def _moving_shadow(h=48, w=96, n=60):
+    """A dark band (2 code values deep) sweeping left to right over a textured wall."""
+    rng = np.random.default_rng(3)
+    wall = 110 + 20 * rng.random((h, w, 1)) + np.array([5.0, 0.0, -5.0])
+
+    def fn(i):
+        x = np.arange(w)
+        centre = (i / n) * w
+        shadow = -2.0 * np.exp(-0.5 * ((x - centre) / 6.0) ** 2)
+        return wall + shadow[None, :, None]
+
+    return fn
+
+
+def test_stplot_npz_format_and_streak(tmp_path, run_cli):
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 60, pix_fmt="yuv444p")
+    out = tmp_path / "p.npz"
+    code, stdout, err = run_cli("stplot", clip, "-o", out, "--json", "--roi", "0,0,96,48", "--bins", "32")
+    assert code == 0, err
+    summary = json.loads(stdout)
+    assert summary["frames"] == 60 and summary["bins"] == 32 and summary["roi"] == [0, 0, 96, 48]
+    with np.load(out, allow_pickle=False) as npz:
+        assert set(npz.files) >= {"horizontal", "vertical", "time", "h_mean", "v_mean", "meta"}
+        h, v, t = npz["horizontal"], npz["vertical"], npz["time"]
+        meta = json.loads(str(npz["meta"]))
+    assert h.dtype == np.float32 and h.shape == (32, 60, 3) and v.shape == (32, 60, 3)
+    assert meta["format"] == "wallcli.stplot" and meta["fps"] == 30.0 and meta["mean"] == "clip"
+    assert np.allclose(t, np.arange(60) / 30, atol=1e-6)
+    assert np.allclose(h.mean(axis=1), 0, atol=1e-4)  # mean removed
+    # The shadow's minimum moves left to right: a slanted streak.
+    darkest = h.mean(axis=2)[:, 5:55].argmin(axis=0)
+    assert np.corrcoef(np.arange(5, 55), darkest)[0, 1] > 0.95
+    # Vertical plot: the band covers all rows equally, so every row sees the same signal.
+    assert np.allclose(v.mean(axis=2), v.mean(axis=(0, 2))[None, :], atol=0.15)
+
+
+def test_stplot_png_and_styles(tmp_path, run_cli):
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
+    for style in ("rgb", "diverging"):
+        png = tmp_path / f"{style}.png"
+        code, stdout, err = run_cli("stplot", clip, "--png", png, "--style", style)
+        assert code == 0, err
+        assert stdout == ""
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("mode", ["window", "ema"])
+def test_running_means_follow_a_step(mode):
+    t = np.arange(300) / 30.0
+    rows = np.where(t < 5, 100.0, 110.0)[:, None]
+    out = remove_mean(rows, t, mode, seconds=1.0)
+    assert abs(out[100, 0]) < 1e-6  # settled before the step
+    assert out[155, 0] > 5  # the step shows up as signal ...
+    assert abs(out[-1, 0]) < 0.1  # ... and is absorbed within a few time constants
+
+
+def test_stplot_requires_an_action(tmp_path, run_cli):
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 5)
+    code, _, err = run_cli("stplot", clip)
+    assert code == 2 and err.startswith("Error:")

@@ -1,0 +1,140 @@
+"""The streaming reader on the formats and damage real files have."""
+
+import subprocess
+import sys
+import warnings
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from clips import write_clip
+from wallcli.errors import WallcliError
+from wallcli.io.video import open_video
+from wallcli.signal.blocks import rgb_grid
+
+
+def _gradient(h, w, level=100.0):
+    def fn(i):
+        x = np.linspace(0, 60, w)[None, :, None]
+        return np.broadcast_to(level + x + np.array([10.0, 0.0, -10.0]) + 2 * i, (h, w, 3)).copy()
+    return fn
+
+
+@pytest.mark.parametrize(
+    "codec,pix_fmt,size",
+    [
+        ("libx264", "yuv420p", (48, 64)),
+        ("libx264", "yuv444p", (48, 64)),
+        ("ffv1", "yuv420p10le", (48, 64)),
+        ("ffv1", "gray", (48, 64)),
+        ("libx264", "yuv444p", (37, 61)),  # odd frame size
+        ("ffv1", "yuv420p", (37, 61)),  # odd size with 4:2:0 chroma
+    ],
+)
+def test_formats_give_the_right_rgb_means(tmp_path, codec, pix_fmt, size):
+    h, w = size
+    fn = _gradient(h, w)
+    path = write_clip(tmp_path / "c.mkv", fn, 5, codec=codec, pix_fmt=pix_fmt)
+    with open_video(path) as reader:
+        assert reader.info.width == w and reader.info.height == h
+        assert reader.info.fps == Fraction(30)
+        frames = list(reader.frames())
+    assert [f.index for f in frames] == list(range(5))
+    assert np.allclose([f.time for f in frames], np.arange(5) / 30, atol=1e-3)  # mkv: ms timestamps
+    for f in frames:
+        grid = rgb_grid(f.planes, (0, 0, w, h), 1, 1)[0, 0]
+        truth = np.asarray(fn(f.index)).reshape(-1, 3).mean(axis=0)
+        if pix_fmt == "gray":
+            truth = np.full(3, truth @ [0.299, 0.587, 0.114])
+        # 8-bit YUV round trips cost up to ~1 code value per channel; the mean must stay close.
+        assert np.abs(grid - truth).max() < 1.5, (grid, truth)
+        full = f.planes.rgb()
+        assert full.shape == (h, w, 3) and full.dtype == np.float32
+        assert np.allclose(full.reshape(-1, 3).mean(axis=0), grid, atol=0.6)
+
+
+def test_ten_bit_keeps_sub_8bit_precision(tmp_path):
+    import av
+
+    h, w = 32, 32
+    path = tmp_path / "deep.mkv"
+    with av.open(str(path), "w") as c:
+        s = c.add_stream("ffv1", rate=30)
+        s.width, s.height, s.pix_fmt = w, h, "gray10le"
+        for i in range(3):
+            arr = np.full((h, w), 400 + i, np.uint16)  # one 10-bit step = 0.25 8-bit code values
+            for p in s.encode(av.VideoFrame.from_ndarray(arr, format="gray10le")):
+                c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+    with open_video(path) as reader:
+        values = [rgb_grid(f.planes, (0, 0, w, h), 1, 1)[0, 0, 0] for f in reader.frames()]
+    assert np.allclose(np.diff(values), 0.25)
+
+
+def test_variable_frame_rate_uses_pts(tmp_path):
+    pts = [0, 1, 3, 4, 8, 9]  # in 1/30 s units: gaps of 1, 2 and 4 frames
+    path = write_clip(tmp_path / "vfr.mkv", _gradient(32, 32), len(pts), codec="ffv1", pix_fmt="yuv444p",
+                      pts_fn=lambda i: pts[i], time_base=Fraction(1, 30))
+    with open_video(path) as reader, warnings.catch_warnings():
+        warnings.simplefilter("error")  # gaps in time are not damage
+        times = [f.time for f in reader.frames()]
+    assert np.allclose(times, np.array(pts) / 30, atol=1e-3)
+
+
+def test_audio_track_is_ignored(tmp_path):
+    path = write_clip(tmp_path / "av.mp4", _gradient(32, 32), 10, audio=True)
+    with open_video(path) as reader:
+        assert len(list(reader.frames())) == 10
+
+
+def test_corrupt_packets_are_skipped_with_a_warning(tmp_path):
+    path = write_clip(tmp_path / "c.ts", lambda i: np.random.default_rng(i).uniform(0, 255, (64, 64, 3)),
+                      60, fmt="mpegts", options={"crf": "20", "preset": "ultrafast", "g": "10"})
+    data = bytearray(path.read_bytes())
+    rng = np.random.default_rng(0)
+    for pos in rng.integers(len(data) // 3, 2 * len(data) // 3, 40):
+        data[pos] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with open_video(path) as reader, pytest.warns(UserWarning):
+        n = len(list(reader.frames()))
+    assert 10 < n <= 60
+
+
+def test_truncated_stream_gives_frames_before_the_damage(tmp_path):
+    path = write_clip(tmp_path / "t.mkv", _gradient(32, 32), 60, codec="ffv1", pix_fmt="yuv444p")
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with open_video(path) as reader, pytest.warns(UserWarning, match="truncated|damaged"):
+        n = len(list(reader.frames()))
+    assert 10 < n < 60
+
+
+def test_stdin_stream(tmp_path):
+    path = write_clip(tmp_path / "s.nut", _gradient(32, 48), 12, codec="ffv1", pix_fmt="yuv444p", fmt="nut")
+    code = (
+        "from wallcli.io.video import open_video\n"
+        "r = open_video('-')\n"
+        "print(sum(1 for _ in r.frames()), r.info.width, r.info.height)\n"
+    )
+    with open(path, "rb") as fh:
+        out = subprocess.run([sys.executable, "-c", code], stdin=fh, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["12", "48", "32"]
+
+
+@pytest.mark.parametrize("content", [b"", b"this is not a video\n" * 10])
+def test_unreadable_files(tmp_path, content):
+    path = tmp_path / "bad.mp4"
+    path.write_bytes(content)
+    with pytest.raises(WallcliError):
+        open_video(path)
+
+
+def test_reader_is_single_pass(tmp_path):
+    path = write_clip(tmp_path / "c.mp4", _gradient(32, 32), 3)
+    with open_video(path) as reader:
+        list(reader.frames())
+        with pytest.raises(RuntimeError):
+            list(reader.frames())

@@ -1,0 +1,108 @@
+import json
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from wallcli.errors import WallcliError  # noqa: E402
+from wallcli.train.augment import augment  # noqa: E402
+from wallcli.train.data import ShardDataset, split_validation  # noqa: E402
+from wallcli.train.loop import TrainConfig, evaluate, train  # noqa: E402
+
+
+def test_dataset_plan_covers_indices_once(make_dataset):
+    ds = ShardDataset(make_dataset("count", 50, shards=3), "count", buffer_windows=20)
+    idx = np.arange(3, 50)
+    batches = ds.plan(idx, 8, np.random.default_rng(1))
+    flat = np.concatenate(batches)
+    assert sorted(flat.tolist()) == idx.tolist()  # 47 = 5*8 + 7: last batch kept (size >= 2)
+    again = ds.plan(idx, 8, np.random.default_rng(1))
+    assert all(np.array_equal(a, b) for a, b in zip(batches, again))
+    b = ds.gather(np.array([49, 0, 20]))
+    assert b["horizontal"].shape == (3, 64, 256, 3) and b["label"].shape == (3,)
+
+
+def test_dataset_rejects_wrong_task_and_missing_manifest(make_dataset, tmp_path):
+    root = make_dataset("count", 8)
+    with pytest.raises(WallcliError, match="count"):
+        ShardDataset(root, "activity")
+    with pytest.raises(WallcliError, match="dataset.json"):
+        ShardDataset(tmp_path, "count")
+
+
+def test_split_validation_is_disjoint_and_seeded():
+    tr, va = split_validation(100, 0.1, 3)
+    assert len(va) == 10 and not set(tr) & set(va) and len(tr) + len(va) == 100
+    assert np.array_equal(va, split_validation(100, 0.1, 3)[1])
+
+
+def test_augment_preserves_shapes_and_is_seeded():
+    rng = np.random.default_rng(0)
+    b = {"horizontal": rng.normal(size=(6, 64, 256, 3)).astype(np.float32),
+         "vertical": rng.normal(size=(6, 64, 256, 3)).astype(np.float32), "label": np.arange(6)}
+    a1 = augment(b, ["horizontal", "vertical"], np.random.default_rng(5))
+    a2 = augment(b, ["horizontal", "vertical"], np.random.default_rng(5))
+    assert a1["horizontal"].shape == b["horizontal"].shape and a1["horizontal"].dtype == np.float32
+    assert np.array_equal(a1["vertical"], a2["vertical"])
+    assert not np.array_equal(a1["horizontal"], b["horizontal"])
+    assert np.array_equal(a1["label"], b["label"])
+
+
+def _cfg(tmp_path, data, **kw):
+    base = dict(task="count", data=data, out=tmp_path / "m.onnx", epochs=2, batch_size=16, threads=2, seed=0,
+                val_fraction=0.125)
+    base.update(kw)
+    return TrainConfig(**base)
+
+
+def test_two_epochs_reduce_loss_and_checkpoint(make_dataset, tmp_path):
+    data = make_dataset("count", 64)
+    cfg = _cfg(tmp_path, data)
+    events = []
+    torch.manual_seed(0)
+    res = train(cfg, lambda kind, **f: events.append((kind, f)))
+    assert [h["epoch"] for h in res["history"]] == [1, 2]
+    assert cfg.checkpoint_path().is_file()
+    ds = res["dataset"]
+    tr, _ = split_validation(ds.n, cfg.val_fraction, cfg.seed)
+    from wallcli.train.nets import build
+
+    torch.manual_seed(cfg.seed)
+    fresh = build("count").to(memory_format=torch.channels_last)  # same init as the run
+    before = evaluate(fresh, ds, tr, 32)["loss"]
+    after = evaluate(res["net"], ds, tr, 32)["loss"]
+    assert after < before
+    kinds = [k for k, _ in events]
+    assert kinds.count("epoch_end") == 2 and "step" in kinds and "checkpoint" in kinds
+    v = res["validation"]
+    assert v["windows"] == 8 and np.array(v["confusion_matrix"]).sum() == 8
+
+
+def test_interrupted_run_resumes_exactly(make_dataset, tmp_path):
+    data = make_dataset("count", 40)
+    straight = train(_cfg(tmp_path, data, out=tmp_path / "a.onnx", epochs=2))
+
+    def stop_after_two_steps(kind, **f):
+        if kind == "step" and f["epoch"] == 1 and f["batch"] == 1:
+            raise KeyboardInterrupt
+
+    cfg = _cfg(tmp_path, data, out=tmp_path / "b.onnx", epochs=2)
+    with pytest.raises(KeyboardInterrupt):
+        train(cfg, stop_after_two_steps)
+    ck = torch.load(cfg.checkpoint_path(), weights_only=False)
+    assert (ck["epoch"], ck["batch"]) == (1, 1)
+    events = []
+    resumed = train(cfg, lambda kind, **f: events.append((kind, f)))
+    assert ("resume", {"epoch": 1, "batch": 1, "path": cfg.checkpoint_path()}) in events
+    sa, sb = straight["net"].state_dict(), resumed["net"].state_dict()
+    for k in sa:
+        assert torch.allclose(sa[k].float(), sb[k].float(), atol=1e-6), k
+
+
+def test_checkpoint_of_another_run_is_refused(make_dataset, tmp_path):
+    data = make_dataset("count", 24)
+    cfg = _cfg(tmp_path, data, epochs=1)
+    train(cfg)
+    with pytest.raises(WallcliError, match="different run"):
+        train(_cfg(tmp_path, data, epochs=1, seed=7))

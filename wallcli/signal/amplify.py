@@ -1,0 +1,214 @@
+"""The amplified-signal pipeline (seed Figure 1), as a streaming state object.
+
+Everything happens on a small grid of exact block means (``blocks.rgb_grid``), never on full
+frames: spatial area-averaging and temporal mean removal are both linear, so averaging first and
+removing the mean second equals the per-pixel order, at a tiny fraction of the cost, and memory is
+a few grids whatever the video's length. Per frame:
+
+1. ``grid``: the ROI's block means, float64 RGB code values (the caller computes it);
+2. subtract a causal running mean (``ema`` by default, or a trailing ``window``);
+3. optionally smooth in time (one-pole low-pass, time constant ``smooth_seconds``);
+4. display = 128 + gain x signal, float32, *unclipped* (the caller upsamples, then clips).
+
+Warm-up. The ``ema`` mean is an expanding average until it has seen about ``mean_seconds`` of
+video (weight max(1/n, 1 - exp(-dt/tau))), then a true EMA. Initialising an EMA from the first
+frame alone would bake that frame's noise into the mean for many seconds, and a mean starting at
+zero would make the first second blinding; the expanding average has neither problem. The
+``window`` mean (``mean.RunningMean``) is an expanding average until its window fills, too.
+
+Gain. Given, or automatic: the first ``calib_frames`` frames are held back (only their small
+grids, plus whatever payload the caller attaches), the robust sigma (MAD) of their signal over
+all cells, channels and frames is measured, and gain = 127 / (3 sigma), so +-3 robust sigma fill
+the display range, as in the space-time plot PNGs. The gain then stays fixed for the whole video
+(a constant gain keeps brightness comparable over time: a person entering later shows up as
+stronger, instead of being normalised away). The sigma is floored at the quantisation noise of a
+block mean, so a perfectly still calibration second cannot produce an absurd gain.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from typing import Any
+
+import numpy as np
+
+from wallcli.plots.figure import robust_sigma
+from wallcli.signal.mean import RunningMean
+
+MEAN_MODES = ("ema", "window")
+GREY = 128.0
+# +-3 robust sigma onto +-127 display levels (same convention as plots.stplot.auto_gain).
+SIGMAS_TO_FULL_SCALE = 3.0
+
+
+def grid_shape(width: int, height: int, cells: int) -> tuple[int, int]:
+    """(rows, cols) of a grid with ``cells`` blocks along the longer side and near-square blocks.
+
+    Never more blocks than pixels: a block is at least one source pixel.
+    """
+    cells = max(1, int(cells))
+    if width >= height:
+        cols = min(cells, width)
+        rows = max(1, min(height, round(cols * height / width)))
+    else:
+        rows = min(cells, height)
+        cols = max(1, min(width, round(rows * width / height)))
+    return int(rows), int(cols)
+
+
+def quantisation_sigma(block_pixels: float, depth: int = 8) -> float:
+    """Noise of a block mean of ``block_pixels`` uniformly quantised samples, in 8-bit code values."""
+    step = 1.0 / float(1 << max(0, depth - 8))
+    return step / math.sqrt(12.0) / math.sqrt(max(1.0, float(block_pixels)))
+
+
+class _ExpandingEma:
+    """EMA with time constant ``seconds`` whose first ~seconds are an expanding (cumulative) mean."""
+
+    def __init__(self, seconds: float):
+        self.seconds = float(seconds)
+        self._mean: np.ndarray | None = None
+        self._t = 0.0
+        self._n = 0
+
+    def update(self, t: float, x: np.ndarray) -> np.ndarray:
+        self._n += 1
+        if self._mean is None:
+            self._mean = np.array(x, dtype=np.float64, copy=True)
+        else:
+            a = 1.0 - math.exp(-max(t - self._t, 0.0) / self.seconds)
+            self._mean += max(a, 1.0 / self._n) * (x - self._mean)
+        self._t = t
+        return self._mean
+
+
+class Amplifier:
+    """Feed block-mean grids in time order with :meth:`push`; get display grids back.
+
+    ``push`` returns a list of ``(payload, display)`` pairs: empty while the automatic gain is
+    still calibrating, then everything held back at once, then one pair per call. Call
+    :meth:`flush` at the end of the stream to get frames still held back (a clip shorter than
+    the calibration). Payloads are returned untouched, in order (the CLI passes the original frame
+    for ``--side-by-side``).
+    """
+
+    def __init__(
+        self,
+        *,
+        mean: str = "ema",
+        mean_seconds: float = 10.0,
+        smooth_seconds: float = 0.0,
+        gain: float | None = None,
+        calib_frames: int = 60,
+        sigma_floor: float = 0.0,
+    ):
+        if mean not in MEAN_MODES:
+            raise ValueError(f"mean must be one of {MEAN_MODES}, got {mean!r}")
+        if not mean_seconds > 0:
+            raise ValueError("mean_seconds must be > 0")
+        if smooth_seconds < 0:
+            raise ValueError("smooth_seconds must be >= 0")
+        self._mean = _ExpandingEma(mean_seconds) if mean == "ema" else RunningMean("window", mean_seconds)
+        self.smooth_seconds = float(smooth_seconds)
+        self.gain: float | None = None if gain is None else float(gain)
+        self.auto_gain = gain is None
+        self.sigma: float | None = None  # the robust sigma the automatic gain came from
+        self.calib_frames = max(2, int(calib_frames))
+        self.sigma_floor = float(sigma_floor)
+        self.frames = 0
+        self._smooth: np.ndarray | None = None
+        self._t_prev = 0.0
+        self._held: deque = deque()
+
+    def signal(self, t: float, grid: np.ndarray) -> np.ndarray:
+        """Mean-removed (and optionally smoothed) signal of one grid, float64 code values."""
+        grid = np.asarray(grid, dtype=np.float64)
+        s = grid - self._mean.update(float(t), grid)
+        if self.smooth_seconds > 0:
+            if self._smooth is None:
+                self._smooth = s.copy()
+            else:
+                b = 1.0 - math.exp(-max(t - self._t_prev, 0.0) / self.smooth_seconds)
+                self._smooth += b * (s - self._smooth)
+            s = self._smooth.copy()
+        self._t_prev = float(t)
+        return s
+
+    def _display(self, s: np.ndarray) -> np.ndarray:
+        return (GREY + self.gain * s).astype(np.float32)
+
+    def _calibrate(self) -> None:
+        signals = [s for _, s in self._held]
+        # The first frame's signal is exactly zero (the mean is that frame): leave it out.
+        sample = np.stack(signals[1:] if len(signals) > 1 else signals)
+        sigma = max(robust_sigma(sample), self.sigma_floor, 1e-6)
+        self.sigma = float(sigma)
+        self.gain = (GREY - 1.0) / (SIGMAS_TO_FULL_SCALE * sigma)
+
+    def _release(self) -> list[tuple[Any, np.ndarray]]:
+        out = [(p, self._display(s)) for p, s in self._held]
+        self._held.clear()
+        return out
+
+    def push(self, t: float, grid: np.ndarray, payload: Any = None) -> list[tuple[Any, np.ndarray]]:
+        s = self.signal(t, grid)
+        self.frames += 1
+        if self.gain is not None:
+            return [(payload, self._display(s))]
+        self._held.append((payload, s.astype(np.float32)))
+        if len(self._held) < self.calib_frames:
+            return []
+        self._calibrate()
+        return self._release()
+
+    def flush(self) -> list[tuple[Any, np.ndarray]]:
+        if not self._held:
+            return []
+        if self.gain is None:
+            self._calibrate()
+        return self._release()
+
+
+# -- display: from grids and planes to uint8 RGB panels -----------------------------------------
+def render_panel(display: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Upsample a display grid (rows, cols, 3) bilinearly to ``width`` x ``height`` uint8 RGB.
+
+    Interpolation happens in float; clipping to 0-255 is the very last step, so out-of-range cells
+    do not bend the interpolation between their neighbours.
+    """
+    import cv2
+
+    img = cv2.resize(np.ascontiguousarray(display, dtype=np.float32), (int(width), int(height)),
+                     interpolation=cv2.INTER_LINEAR)
+    np.rint(img, out=img)
+    np.clip(img, 0.0, 255.0, out=img)
+    return img.astype(np.uint8)
+
+
+def original_panel(planes, roi: tuple[int, int, int, int], width: int, height: int) -> np.ndarray:
+    """The ROI of the decoded frame as uint8 RGB at ``width`` x ``height`` (display only).
+
+    Each plane is cropped and resized on its own before the colour conversion, so the float work
+    is done at panel size, not at source size.
+    """
+    import cv2
+
+    x, y, w, h = roi
+    size = (int(width), int(height))
+
+    def fit(plane: np.ndarray, sx: int, sy: int) -> np.ndarray:
+        r0, r1 = y >> sy, -((-(y + h)) >> sy)
+        c0, c1 = x >> sx, -((-(x + w)) >> sx)
+        crop = np.ascontiguousarray(plane[r0:r1, c0:c1])
+        down = crop.shape[1] > size[0] or crop.shape[0] > size[1]
+        return cv2.resize(crop, size, interpolation=cv2.INTER_AREA if down else cv2.INTER_LINEAR)
+
+    yy = fit(planes.y, 0, 0)
+    if planes.u is None:
+        rgb = planes.to_rgb(yy)
+    else:
+        rgb = planes.to_rgb(yy, fit(planes.u, planes.sub_x, planes.sub_y), fit(planes.v, planes.sub_x, planes.sub_y))
+    np.rint(rgb, out=rgb)
+    np.clip(rgb, 0.0, 255.0, out=rgb)
+    return rgb.astype(np.uint8)
