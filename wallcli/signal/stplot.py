@@ -3,7 +3,7 @@
 
 Layout: ``horizontal`` and ``vertical`` are float32 arrays (bins, T, 3) = position x time x RGB,
 in 8-bit code values. Horizontal position runs left to right, vertical position top to bottom.
-Both plots come from one bins x bins grid of exact block means, so they are consistent.
+Both plots are exact area means (integer sums) of the same ROI.
 Mean removal commutes with spatial averaging (both are linear), so removing the mean from the
 small plot equals removing it from every pixel first.
 """
@@ -16,7 +16,7 @@ from typing import Callable, Iterable
 import numpy as np
 
 from wallcli import __version__
-from wallcli.signal.blocks import Roi, check_roi, rgb_grid
+from wallcli.signal.blocks import Roi, check_roi, rgb_projections
 from wallcli.signal.mean import MODES, remove_mean
 
 FORMAT = "wallcli.stplot"
@@ -49,9 +49,7 @@ class RowReducer:
         self.roi, self.bins = roi, int(bins)
 
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
-        grid = rgb_grid(planes, self.roi, self.bins, self.bins)
-        # Equal-area blocks: the mean over rows of block means is the mean over the ROI's rows.
-        return grid.mean(axis=0), grid.mean(axis=1)
+        return rgb_projections(planes, self.roi, self.bins)
 
 
 class _Growing:
