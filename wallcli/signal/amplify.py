@@ -186,11 +186,24 @@ def render_panel(display: np.ndarray, width: int, height: int) -> np.ndarray:
     return img.astype(np.uint8)
 
 
+def _rgb_affine(planes) -> np.ndarray:
+    """The 3x4 matrix of ``planes.to_rgb`` (affine in the plane values), for ``cv2.transform``."""
+    if planes.u is None:
+        z, e = np.zeros(1), np.ones(1)
+        off = planes.to_rgb(z)[0].astype(np.float64)
+        col = planes.to_rgb(e)[0] - off
+        return np.column_stack([col, off])
+    basis = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], np.float64)
+    out = planes.to_rgb(basis[:, 0], basis[:, 1], basis[:, 2]).astype(np.float64)
+    return np.column_stack([out[1] - out[0], out[2] - out[0], out[3] - out[0], out[0]])
+
+
 def original_panel(planes, roi: tuple[int, int, int, int], width: int, height: int) -> np.ndarray:
     """The ROI of the decoded frame as uint8 RGB at ``width`` x ``height`` (display only).
 
-    Each plane is cropped and resized on its own before the colour conversion, so the float work
-    is done at panel size, not at source size.
+    Each plane is cropped and resized on its own, then the colour matrix is applied at panel size
+    by ``cv2.transform`` (rounding and saturating in C): converting the full-size frame to float
+    RGB first would cost more than everything else amplify does.
     """
     import cv2
 
@@ -200,15 +213,19 @@ def original_panel(planes, roi: tuple[int, int, int, int], width: int, height: i
     def fit(plane: np.ndarray, sx: int, sy: int) -> np.ndarray:
         r0, r1 = y >> sy, -((-(y + h)) >> sy)
         c0, c1 = x >> sx, -((-(x + w)) >> sx)
-        crop = np.ascontiguousarray(plane[r0:r1, c0:c1])
+        crop = plane[r0:r1, c0:c1]
         down = crop.shape[1] > size[0] or crop.shape[0] > size[1]
         return cv2.resize(crop, size, interpolation=cv2.INTER_AREA if down else cv2.INTER_LINEAR)
 
     yy = fit(planes.y, 0, 0)
     if planes.u is None:
-        rgb = planes.to_rgb(yy)
+        stack = yy[..., None]  # one channel in, three out (3x2 matrix)
     else:
-        rgb = planes.to_rgb(yy, fit(planes.u, planes.sub_x, planes.sub_y), fit(planes.v, planes.sub_x, planes.sub_y))
+        stack = cv2.merge([yy, fit(planes.u, planes.sub_x, planes.sub_y), fit(planes.v, planes.sub_x, planes.sub_y)])
+    m = _rgb_affine(planes)
+    if stack.dtype == np.uint8:
+        return cv2.transform(stack, m)  # uint8 in, uint8 out: rounded and saturated
+    rgb = cv2.transform(stack.astype(np.float32), m)
     np.rint(rgb, out=rgb)
     np.clip(rgb, 0.0, 255.0, out=rgb)
     return rgb.astype(np.uint8)

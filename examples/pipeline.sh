@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Set up wallcli (once, into .venv) and run the main job on a bundled example clip:
+# how strong is the signal, the space-time plots, how many people, what they do, and the
+# amplified video. Outputs go to examples/out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ ! -x .venv/bin/wallcli ]; then
+  python3 -m venv .venv
+  .venv/bin/python -m pip install -q --upgrade pip
+  .venv/bin/python -m pip install -q .
+fi
+w=.venv/bin/wallcli
+clip=${1:-examples/one_walking.mp4}
+out=examples/out
+mkdir -p "$out"
+
+echo "== signal and noise ($clip)" >&2
+$w snr "$clip"
+echo "== space-time plots -> $out/plots.npz, $out/plots.png" >&2
+$w stplot "$clip" -o "$out/plots.npz" --png "$out/plots.png" --force
+echo "== how many people (from the plots)" >&2
+$w count "$out/plots.npz" --json
+echo "== what they are doing" >&2
+$w activity "$clip"
+echo "== amplified video -> $out/amplified.mp4" >&2
+$w amplify "$clip" "$out/amplified.mp4" --side-by-side --force

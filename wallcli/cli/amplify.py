@@ -1,0 +1,141 @@
+"""``wallcli amplify``: video -> the amplified-signal video (seed Figure 1), in one streaming pass."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, parse_roi
+
+VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
+# Frames held back while the automatic gain calibrates are kept whole only with --side-by-side
+# (the original panel); cap that buffer so 4K input cannot blow the memory budget.
+PRESETS = ("ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower", "veryslow")
+SIDE_BUFFER_BYTES = 64 * 1024 * 1024
+
+
+def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
+    """'0.5' (factor) or '640x360' (pixels) -> even (width, height) for H.264 4:2:0."""
+    from wallcli.errors import UsageError
+
+    t = text.strip().lower()
+    try:
+        if "x" in t:
+            w_s, h_s = t.split("x", 1)
+            w, h = float(int(w_s)), float(int(h_s))
+        else:
+            f = float(t)
+            w, h = width * f, height * f
+    except ValueError:
+        raise UsageError(f"--scale must be a factor like 0.5 or a size like 640x360 (got {text!r})") from None
+    if not (w > 0 and h > 0) or w > 16384 or h > 16384:
+        raise UsageError(f"--scale gives an unusable output size {w:.0f}x{h:.0f}")
+    return max(2, 2 * round(w / 2)), max(2, 2 * round(h / 2))
+
+
+def amplify(
+    input: str = input_argument(),
+    output: Path = typer.Argument(..., help="Output video (.mp4, .mov, .m4v or .mkv; H.264).", show_default=False),
+    gain: Optional[float] = typer.Option(None, "--gain", min=0.0, help="Display levels per code value of signal "
+                                         "(output = 128 + gain x signal). Default: automatic, +-3 robust sigma of "
+                                         "the first --gain-seconds fill the range, then fixed."),
+    gain_seconds: float = typer.Option(2.0, "--gain-seconds", min=0.05, help="Video used to measure the automatic gain "
+                                       "(those frames are written once it is known)."),
+    cells: int = typer.Option(64, "--cells", min=1, max=4096, help="Blocks along the longer side of the ROI; each "
+                              "block is averaged exactly (noise falls as 1/sqrt(pixels)). Fewer = less noise, coarser."),
+    mean: str = typer.Option("ema", "--mean", help="Running temporal mean removed per block: 'ema' (exponential) "
+                             "or 'window' (trailing moving average). Both start as an expanding average."),
+    mean_seconds: float = typer.Option(10.0, "--mean-seconds", min=0.01, help="Time constant of 'ema' / span of 'window'."),
+    smooth: float = typer.Option(0.0, "--smooth", min=0.0, help="Temporal smoothing time constant in seconds "
+                                 "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion."),
+    scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5) or WIDTHxHEIGHT."),
+    side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
+    roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Output shows the ROI only."),
+    crf: int = typer.Option(18, "--crf", min=0, max=51, help="H.264 quality (lower = better, bigger)."),
+    preset: str = typer.Option("superfast", "--preset", help="x264 speed preset, ultrafast ... veryslow. superfast: 2x faster than veryfast, same size here; ultrafast: 2x faster again, 2x bigger."),
+    json_out: bool = typer.Option(False, "--json", help="Print a summary (gain, frames, fps, size) as JSON on stdout."),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+) -> None:
+    """Make the invisible visible: a video of the wall's tiny light changes, amplified.
+
+    Each pixel's temporal mean (the static room) is removed, the wall is area-averaged into
+    blocks (the noise falls, the broad shadows of people stay), and the rest is shown as
+    128 + gain x signal: grey where nothing changes, coloured where someone blocks or reflects
+    light. One streaming pass; memory does not grow with the video's length.
+
+    \b
+    Examples:
+      wallcli amplify clip.mp4 amp.mp4
+      wallcli amplify clip.mp4 amp.mp4 --side-by-side --scale 0.5 --smooth 0.1
+      wallcli amplify clip.mp4 amp.mp4 --roi 100,50,640,360 --gain 200 --cells 32
+    """
+    from wallcli.errors import UsageError
+
+    if mean not in ("ema", "window"):
+        raise UsageError(f"--mean must be ema or window (got {mean!r})")
+    if preset not in PRESETS:
+        raise UsageError(f"--preset must be one of {', '.join(PRESETS)} (got {preset!r})")
+    if output.suffix.lower() not in VIDEO_SUFFIXES:
+        raise UsageError(f"OUTPUT must end in {', '.join(VIDEO_SUFFIXES)} (got {output})")
+    roi_t = parse_roi(roi)
+
+    import numpy as np
+
+    from wallcli.cli.output import console_err, emit_json, progress
+    from wallcli.errors import WallcliError
+    from wallcli.io.video import open_video
+    from wallcli.io.writer import VideoWriter, atomic_path, check_output
+    from wallcli.signal.amplify import Amplifier, grid_shape, original_panel, quantisation_sigma, render_panel
+    from wallcli.signal.blocks import check_roi, rgb_grid
+
+    check_output(output, force=force, inputs=[input])
+    with open_video(input, threads=threads) as reader:
+        info = reader.info
+        roi_t = check_roi(roi_t, info.width, info.height)
+        _, _, rw, rh = roi_t
+        pw, ph = parse_scale(scale, rw, rh)
+        rows, cols = grid_shape(rw, rh, cells)
+        calib = max(2, round(gain_seconds * float(info.fps)))
+        if side_by_side:
+            calib = max(2, min(calib, SIDE_BUFFER_BYTES // (pw * ph * 3)))
+        depth = 8
+        amp = None
+        out_w = 2 * pw if side_by_side else pw
+        frames = 0
+        with atomic_path(output, force=force) as tmp:
+            with VideoWriter(tmp, info.fps, out_w, ph, crf=crf, preset=preset) as writer:
+
+                def write(pairs) -> None:
+                    for left, display in pairs:
+                        right = render_panel(display, pw, ph)
+                        writer.write(right if left is None else np.concatenate([left, right], axis=1))
+
+                with progress("amplify", info.frame_count) as advance:
+                    for frame in reader.frames():
+                        planes = frame.planes
+                        if amp is None:
+                            depth = planes.depth
+                            floor = quantisation_sigma(rw * rh / (rows * cols), depth)
+                            amp = Amplifier(mean=mean, mean_seconds=mean_seconds, smooth_seconds=smooth,
+                                            gain=gain, calib_frames=calib, sigma_floor=floor)
+                        grid = rgb_grid(planes, roi_t, rows, cols)
+                        left = original_panel(planes, roi_t, pw, ph) if side_by_side else None
+                        write(amp.push(frame.time, grid, left))
+                        frames += 1
+                        advance()
+                write(amp.flush() if amp is not None else [])
+                if frames < 2:
+                    raise WallcliError(f"{input}: only {frames} frame(s); amplify needs at least 2")
+    summary = {
+        "input": input, "output": str(output), "frames": frames, "fps": float(info.fps),
+        "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}", "width": out_w, "height": ph,
+        "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds, "smooth": smooth,
+        "gain": amp.gain, "gain_mode": "auto" if amp.auto_gain else "fixed", "sigma": amp.sigma,
+    }
+    console_err.print(f"amplify: {frames} frames -> {output} ({out_w}x{ph}, gain {amp.gain:.4g} "
+                      f"{'auto' if amp.auto_gain else 'given'}, grid {cols}x{rows})", highlight=False)
+    if json_out:
+        emit_json(summary)
