@@ -38,12 +38,21 @@ def _wallcli(args: list[str]) -> None:
                 raise RuntimeError(f"wallcli {' '.join(args)} exited with {exc.code}") from None
 
 
+def _peak_rss_mb() -> float:
+    # VmHWM belongs to this process image; ru_maxrss would inherit the parent's peak across fork.
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
 def main() -> None:
     kind, rest = sys.argv[1], sys.argv[2:]
     t0 = time.perf_counter()
     frames = _decode(rest[0]) if kind == "decode" else (_wallcli(rest) or None)
     seconds = time.perf_counter() - t0
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    rss = _peak_rss_mb()
     print(json.dumps({"seconds": seconds, "frames": frames, "peak_rss_mb": rss}))
 
 

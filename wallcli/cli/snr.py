@@ -1,0 +1,271 @@
+"""``wallcli snr``: how much wall signal a video carries, where, and how it grows with averaging;
+or, with ``--predict``, what the physics of seed §3 expects for a scene and camera."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+from wallcli.cli.common import FORCE_HELP, THREADS_HELP
+
+# Parameters of --predict, by the name --sweep uses: (option, default, help).
+PREDICT_PARAMS = {
+    "distance": ("--distance", 2.0, "Person-to-wall distance d (m)."),
+    "radius": ("--radius", 0.25, "Person radius r (m); the person is a disk of area A = pi r^2 facing the wall."),
+    "area": ("--area", None, "Person area A (m^2), instead of --radius."),
+    "albedo": ("--albedo", 0.7, "Wall albedo alpha (0-1)."),
+    "person_radiance": ("--person-radiance", 20.0, "Person radiance L_p, in code values (what a white wall lit by it alone would record)."),
+    "background_radiance": ("--background-radiance", 200.0, "Surroundings' radiance L_s, same units."),
+    "contrast": ("--contrast", None, "L_p - L_s directly, instead of the two radiances."),
+    "occupancy": ("--occupancy", 1.0, "Fraction q of the time the person is there."),
+    "mean_code": ("--mean-code", None, "Camera model: the wall's mean code value (8-bit scale). With --gain, also predicts noise and SNR."),
+    "gain": ("--gain", None, "Camera model: electrons per 8-bit code value."),
+    "read_noise": ("--read-noise", 2.0, "Camera model: read noise (electrons RMS)."),
+    "bits": ("--bits", 8, "Camera model: bit depth (quantisation step 2^(8-bits) on the 8-bit scale)."),
+    "pixels": ("--pixels", 1.0, "Camera model: pixels averaged."),
+    "frames": ("--frames", 1.0, "Camera model: frames averaged."),
+}
+
+
+def snr(
+    input: Optional[str] = typer.Argument(None, help="Video file, http(s)/rtsp URL, or '-' (not needed with --predict).", show_default=False),
+    roi: Optional[str] = typer.Option(None, "--roi", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
+                                      "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
+                                      "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
+                                      "covariances). 'auto' reads the file twice. Default: whole frame."),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object (CONTRACT.md fields, plus extras) on stdout."),
+    heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
+    heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
+                                        "with --predict --sweep, SNR (or signal power) against the swept parameter."),
+    max_pixels: int = typer.Option(32768, "--max-pixels", min=0, help="Pixels measured per frame: a larger ROI is sampled by a regular "
+                                   "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
+                                   "decode speed). 0 = every pixel of the ROI (exact, slower)."),
+    predict_mode: bool = typer.Option(False, "--predict", help="Predict from the scene's physics (seed §3.1) instead of measuring a video."),
+    approx: bool = typer.Option(False, "--approx", help="--predict: far-field coverage A/(pi d^2) instead of the exact r^2/(r^2+d^2)."),
+    sweep: Optional[str] = typer.Option(None, "--sweep", help="--predict: NAME=start:stop:step over any parameter, e.g. distance=1:4:0.25 "
+                                        "(names: " + ", ".join(k.replace("_", "-") for k in PREDICT_PARAMS) + ")."),
+    distance: float = typer.Option(2.0, "--distance", help=PREDICT_PARAMS["distance"][2]),
+    radius: float = typer.Option(0.25, "--radius", help=PREDICT_PARAMS["radius"][2]),
+    area: Optional[float] = typer.Option(None, "--area", help=PREDICT_PARAMS["area"][2]),
+    albedo: float = typer.Option(0.7, "--albedo", help=PREDICT_PARAMS["albedo"][2]),
+    person_radiance: float = typer.Option(20.0, "--person-radiance", help=PREDICT_PARAMS["person_radiance"][2]),
+    background_radiance: float = typer.Option(200.0, "--background-radiance", help=PREDICT_PARAMS["background_radiance"][2]),
+    contrast: Optional[float] = typer.Option(None, "--contrast", help=PREDICT_PARAMS["contrast"][2]),
+    occupancy: float = typer.Option(1.0, "--occupancy", help=PREDICT_PARAMS["occupancy"][2]),
+    mean_code: Optional[float] = typer.Option(None, "--mean-code", help=PREDICT_PARAMS["mean_code"][2]),
+    gain: Optional[float] = typer.Option(None, "--gain", help=PREDICT_PARAMS["gain"][2]),
+    read_noise: float = typer.Option(2.0, "--read-noise", help=PREDICT_PARAMS["read_noise"][2]),
+    bits: int = typer.Option(8, "--bits", min=1, max=16, help=PREDICT_PARAMS["bits"][2]),
+    pixels: float = typer.Option(1.0, "--pixels", min=1.0, help=PREDICT_PARAMS["pixels"][2]),
+    frames: float = typer.Option(1.0, "--frames", min=1.0, help=PREDICT_PARAMS["frames"][2]),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+) -> None:
+    """Measure the wall signal and the noise in a video (seed §4), per colour channel.
+
+    V is the video with each pixel's temporal mean removed and T(V) is V one frame later. The
+    signal is slow and frame noise independent, so noise power = 1/2 Var(V - T(V)), signal power
+    = Var V - 1/2 Var(V - T(V)), SNR = signal / noise (dB). Powers are per pixel in squared 8-bit
+    code values, then again after averaging blocks of 2, 4, 8, 16 and 32 pixels square: white
+    noise falls as 1/pixels averaged, a wall signal much less. One streaming pass.
+
+    \b
+    Examples:
+      wallcli snr clip.mp4 --roi 100,50,640,360 --plot snr.png
+      wallcli snr clip.mp4 --roi auto --heatmap where.png --json
+      wallcli snr --predict --distance 2.5 --mean-code 120 --gain 4 --pixels 10000
+      wallcli snr --predict --sweep distance=1:4:0.25 --plot fade.png
+    """
+    from wallcli.errors import UsageError
+
+    if heatmap_of not in ("signal", "snr"):
+        raise UsageError(f"--heatmap-of must be signal or snr (got {heatmap_of!r})")
+    if predict_mode:
+        params = {k: v for k, v in locals().items() if k in PREDICT_PARAMS}
+        return _predict(params, approx=approx, sweep=sweep, plot=plot, json_out=json_out, force=force)
+    if input is None:
+        raise UsageError("give a video (INPUT), or --predict for the physics alone")
+    if sweep is not None:
+        raise UsageError("--sweep goes with --predict")
+    _measure(input, roi=roi, json_out=json_out, heatmap=heatmap, heatmap_of=heatmap_of, plot=plot,
+             max_pixels=max_pixels, force=force, threads=threads)
+
+
+# ------------------------------------------------------------------------------------- measure
+def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, force, threads) -> None:
+    import warnings
+
+    from wallcli.cli.common import parse_roi
+    from wallcli.cli.output import emit_json, print_table, progress, warn
+    from wallcli.errors import WallcliError
+    from wallcli.io.video import open_video
+    from wallcli.io.writer import check_output
+    from wallcli.signal.blocks import check_roi
+    from wallcli.signal.snr import CHANNELS, GridAccumulator, SnrAccumulator, snr_db
+
+    auto = roi is not None and roi.strip().lower() == "auto"
+    roi_t = None if auto else parse_roi(roi)
+    for out in (heatmap, plot):
+        if out is not None:
+            check_output(out, force=force, inputs=[input])
+    if auto and (input == "-" or not Path(input).exists()):
+        raise WallcliError("--roi auto reads the video twice, so it needs a file (not '-' or a stream)"
+                           if input == "-" or "://" in input else f"no such file: {input}")
+    notes: list[str] = []
+    grid = auto_snr = None
+    if auto:
+        with open_video(input, threads=threads) as reader:
+            full = check_roi(None, reader.info.width, reader.info.height)
+            grid = GridAccumulator(full, 16, covariance=True)
+            with progress("snr: finding the ROI", reader.info.frame_count) as advance:
+                for frame in reader.frames():
+                    grid.update(frame.planes)
+                    advance()
+        roi_t, auto_snr = grid.best_roi()
+    with open_video(input, threads=threads) as reader, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        roi_c = check_roi(roi_t, reader.info.width, reader.info.height)
+        acc = SnrAccumulator(roi_c, max_pixels=max_pixels)
+        if heatmap is not None and grid is None:
+            grid = GridAccumulator(roi_c, 48)
+        feed_grid = grid if (grid is not None and not auto) else None
+        with progress("snr", reader.info.frame_count) as advance:
+            for frame in reader.frames():
+                acc.update(frame.planes)
+                if feed_grid is not None:
+                    feed_grid.update(frame.planes)
+                advance()
+        fps = float(reader.info.fps)
+    notes += [str(w.message) for w in caught]
+    if acc.frames < 3:
+        raise WallcliError(f"{input}: only {acc.frames} frame(s) decoded; the noise estimate needs at least 3 "
+                           "(it compares consecutive frames over time)")
+    res = acc.result()
+    notes += res.warnings
+    top = res.scale(1)
+    result = {
+        "input": input,
+        "roi": list(res.roi),
+        "frames": res.frames,
+        "channels": list(CHANNELS),
+        "signal_power": top.signal_power.tolist(),
+        "noise_power": top.noise_power.tolist(),
+        "snr_db": top.snr_db.tolist(),
+        "scales": [{"block": s.block, "signal_power": s.signal_power.tolist(), "noise_power": s.noise_power.tolist(),
+                    "snr_db": s.snr_db.tolist(), "blocks": s.blocks} for s in res.scales],
+        "fps": fps,
+        "roi_mode": "auto" if auto else ("given" if roi_t is not None else "frame"),
+        "sampled_pixels": res.sampled_pixels,
+        "exact": res.exact,
+        "warnings": notes,
+    }
+    if auto:
+        result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
+                          "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0))}
+    if heatmap is not None:
+        from wallcli.plots.snr import save_heatmap_png
+
+        save_heatmap_png(heatmap, grid, of=heatmap_of, chosen=res.roi if auto else None, title=input, force=force)
+    if plot is not None:
+        from wallcli.plots.snr import save_scales_png
+
+        save_scales_png(plot, result, force=force)
+    if json_out:
+        emit_json(result)
+        return
+    for n in notes:
+        warn(n)
+    how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
+    print_table(
+        f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
+        "powers in 8-bit code values^2",
+        ["block", "signal R / G / B", "noise R / G / B", "SNR dB R / G / B"],
+        [[f"{s['block']}x{s['block']}", _triple(s["signal_power"]), _triple(s["noise_power"]),
+          _triple(s["snr_db"], "{:.1f}")] for s in result["scales"]],
+    )
+
+
+def _triple(v, fmt: str = "{:.4g}") -> str:
+    return " / ".join("-" if x is None or x != x else fmt.format(x) for x in v)
+
+
+# ------------------------------------------------------------------------------------- predict
+def _parse_sweep(text: str) -> tuple[str, list[float]]:
+    import numpy as np
+
+    from wallcli.errors import UsageError
+
+    name, _, rng = text.partition("=")
+    key = name.strip().replace("-", "_")
+    if key not in PREDICT_PARAMS:
+        raise UsageError(f"--sweep: unknown parameter {name!r} (one of "
+                         + ", ".join(k.replace("_", "-") for k in PREDICT_PARAMS) + ")")
+    try:
+        start, stop, step = (float(p) for p in rng.split(":"))
+    except ValueError:
+        raise UsageError(f"--sweep must be NAME=start:stop:step (got {text!r})") from None
+    if step <= 0 or stop < start:
+        raise UsageError("--sweep needs step > 0 and stop >= start")
+    values = np.arange(start, stop + step * 1e-9, step)
+    if len(values) > 10000:
+        raise UsageError("--sweep: more than 10000 values; use a larger step")
+    return key, [float(v) for v in values]
+
+
+def _one(p: dict, approx: bool) -> dict:
+    import math
+
+    from wallcli.signal.snr import predict
+
+    radius = math.sqrt(p["area"] / math.pi) if p["area"] is not None else p["radius"]
+    contrast = p["contrast"] if p["contrast"] is not None else p["person_radiance"] - p["background_radiance"]
+    return predict(distance=p["distance"], radius=radius, albedo=p["albedo"], contrast=contrast,
+                   occupancy=p["occupancy"], approx=approx, mean_code=p["mean_code"], gain=p["gain"],
+                   read_noise=p["read_noise"], bits=int(p["bits"]), pixels=p["pixels"], frames=p["frames"])
+
+
+def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> None:
+    from wallcli.cli.output import emit_json, print_table, warn
+    from wallcli.errors import UsageError
+    from wallcli.io.writer import check_output
+
+    if (params["mean_code"] is None) != (params["gain"] is None):
+        raise UsageError("the camera model needs both --mean-code and --gain")
+    if plot is not None:
+        if sweep is None:
+            raise UsageError("with --predict, --plot draws a --sweep")
+        check_output(plot, force=force)
+    settings = dict(params, approx=approx)
+    if sweep is None:
+        out = _one(params, approx)
+        if json_out:
+            emit_json({"mode": "predict", "parameters": settings, **out})
+            return
+        print_table("snr --predict (seed §3.1)" + (", far-field approximation" if approx else ""),
+                    ["quantity", "value"], [[k, f"{v:.6g}" if v is not None else "-"] for k, v in out.items()])
+        if params["mean_code"] is None:
+            warn("no camera model: give --mean-code and --gain for noise power and SNR")
+        return
+    key, values = _parse_sweep(sweep)
+    if key in ("mean_code", "gain") and (params["mean_code"] is None or params["gain"] is None):
+        params = dict(params, mean_code=params["mean_code"] or 128.0, gain=params["gain"] or 4.0)
+    if key == "radius" and params["area"] is not None:
+        raise UsageError("--sweep radius conflicts with --area")
+    if key in ("person_radiance", "background_radiance") and params["contrast"] is not None:
+        raise UsageError(f"--sweep {key.replace('_', '-')} conflicts with --contrast")
+    rows = [dict(_one(dict(params, **{key: v}), approx), **{key: v}) for v in values]
+    if plot is not None:
+        from wallcli.plots.snr import save_sweep_png
+
+        save_sweep_png(plot, key, rows, force=force)
+    if json_out:
+        emit_json({"mode": "predict", "parameters": settings, "sweep": {"parameter": key.replace("_", "-"), "values": values},
+                   "rows": rows})
+        return
+    cols = [key.replace("_", "-"), "theta", "amplitude", "signal_power"] + (
+        ["noise_power", "snr_db"] if "noise_power" in rows[0] else [])
+    print_table(f"snr --predict, sweeping {key.replace('_', '-')}", cols,
+                [[f"{r[c]:.6g}" if c in r and r[c] is not None else "-" for c in [key] + cols[1:]] for r in rows])

@@ -1,0 +1,459 @@
+"""Signal and noise of a wall video (seed notes §4) and their prediction from physics (§3).
+
+Estimator. V is the video with each pixel's temporal mean removed and T shifts it by one frame.
+The signal is slow, so V - T(V) is (almost) noise alone and frame noise is independent:
+    noise power  = 1/2 Var(V - T(V)),   signal power = Var V - 1/2 Var(V - T(V)).
+Both are computed per pixel (or per block mean) over time, then averaged over pixels, per RGB
+channel, in squared 8-bit code values.
+
+One streaming pass: per frame the RGB values of the measured pixels (float32, never rounded) are
+centred on the first frame, so squares stay small and float64 sums lose nothing to cancellation;
+we keep sums, sums of squares and sums of squared frame differences. Memory is a few copies of
+the measured pixels, whatever the video's length. Block sizes 2..32 come from a pyramid of 2x2
+sums of the already converted frame; their sums are linear in the pixels, so only the squares
+need accumulating per block size.
+
+Which pixels: the whole ROI when it holds at most ``max_pixels`` pixels (exact); otherwise a
+regular lattice of whole 32x32 tiles spread over the ROI, about ``max_pixels`` pixels in all.
+All block sizes come from the same tiles, so the curve over block size compares like with like.
+The powers are averages over pixels, so a spread sample is an unbiased estimate of them; this is
+what keeps a 1080p video at decode speed (a float64 accumulator over 6 M values costs more per
+frame than decoding it).
+
+Chroma: a 4:2:0 pixel's colour is the chroma sample covering it (as in ``blocks.rgb_grid``, whose
+area means this matches), so the ROI is shrunk to whole chroma samples (even x, y, w, h).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+from wallcli.signal.blocks import Roi, rgb_grid
+
+SCALES = (1, 2, 4, 8, 16, 32)
+CHANNELS = ("r", "g", "b")
+TILE = 32
+DEFAULT_MAX_PIXELS = 1 << 15
+CHUNK = 32  # frames summed in float32 before joining the float64 totals
+MIN_FRAMES = 3
+
+
+# ---------------------------------------------------------------------------------- helpers
+def affine_rgb(planes) -> np.ndarray:
+    """(3, 3) matrix M with RGB = M @ (y, u, v) + offset, taken from ``Planes.to_rgb`` itself.
+
+    Variances do not depend on the offset; asking to_rgb keeps one source for the matrices,
+    ranges and bit-depth scaling.
+    """
+    if planes.u is None:
+        rows = np.asarray(planes.to_rgb(np.array([0.0, 1.0])), np.float64)
+        m = np.zeros((3, 3))
+        m[:, 0] = rows[1] - rows[0]
+        return m
+    e = np.eye(4)[:, 1:]  # origin, then one unit step per plane
+    rows = np.asarray(planes.to_rgb(e[:, 0], e[:, 1], e[:, 2]), np.float64)
+    return (rows[1:] - rows[0]).T
+
+
+def footprint(planes) -> tuple[int, int]:
+    """Luma pixels per chroma sample (rows, cols); (1, 1) without subsampled chroma."""
+    if planes.u is None or planes.kind != "yuv":
+        return 1, 1
+    return 1 << planes.sub_y, 1 << planes.sub_x
+
+
+def snap_roi(roi: Roi, fy: int, fx: int) -> Roi:
+    """Shrink ``roi`` inwards to whole chroma samples."""
+    x, y, w, h = roi
+    x1, y1 = -(-x // fx) * fx, -(-y // fy) * fy
+    x2, y2 = (x + w) // fx * fx, (y + h) // fy * fy
+    if x2 - x1 < fx or y2 - y1 < fy:
+        raise WallcliError(f"ROI {x},{y},{w},{h} is smaller than one chroma sample ({fx}x{fy} pixels)")
+    return (x1, y1, x2 - x1, y2 - y1)
+
+
+def _pair(a: np.ndarray, axis: int) -> np.ndarray:
+    """Sums of neighbouring pairs along ``axis`` (a trailing odd element is dropped)."""
+    n = a.shape[axis] // 2 * 2
+    lo = [slice(None)] * a.ndim
+    hi = [slice(None)] * a.ndim
+    lo[axis], hi[axis] = slice(0, n, 2), slice(1, n, 2)
+    return a[tuple(lo)] + a[tuple(hi)]
+
+
+def _halve(a: np.ndarray) -> np.ndarray:
+    """(3, nty, th, ntx, tw) sums of NxN blocks -> sums of 2Nx2N blocks."""
+    return _pair(_pair(a, 2), 4)
+
+
+# ---------------------------------------------------------------------------------- sampling
+@dataclass
+class Lattice:
+    """Where the measured pixels are: ``nty`` x ``ntx`` tiles of ``th`` x ``tw`` pixels."""
+
+    roi: Roi
+    nty: int
+    ntx: int
+    th: int
+    tw: int
+    step_y: int  # pixels between tile origins
+    step_x: int
+    oy: int  # first tile origin (frame pixels)
+    ox: int
+
+    @property
+    def pixels(self) -> int:
+        return self.nty * self.ntx * self.th * self.tw
+
+    @property
+    def exact(self) -> bool:
+        return self.nty == 1 and self.ntx == 1 and (self.th, self.tw) == (self.roi[3], self.roi[2])
+
+    @classmethod
+    def plan(cls, roi: Roi, max_pixels: int) -> "Lattice":
+        x, y, w, h = roi
+        my, mx = h // TILE, w // TILE
+        if max_pixels <= 0 or w * h <= max_pixels or my * mx == 0:
+            return cls(roi, 1, 1, h, w, h, w, y, x)
+        want = max(1, max_pixels // (TILE * TILE))
+        step = max(1, math.ceil(math.sqrt(my * mx / want)))
+        while math.ceil(my / step) * math.ceil(mx / step) > want and step < max(my, mx):
+            step += 1
+        nty, ntx = math.ceil(my / step), math.ceil(mx / step)
+        # Centre the lattice in the ROI so the margins on both sides are alike.
+        oy = y + ((h - ((nty - 1) * step + 1) * TILE) // 2)
+        ox = x + ((w - ((ntx - 1) * step + 1) * TILE) // 2)
+        return cls(roi, nty, ntx, TILE, TILE, step * TILE, step * TILE, oy, ox)
+
+    def view(self, plane: np.ndarray, fy: int = 1, fx: int = 1) -> np.ndarray:
+        """(nty, th/fy, ntx, tw/fx) strided view of the tiles in a (possibly subsampled) plane."""
+        sub = plane[self.oy // fy:, self.ox // fx:]
+        rs, cs = sub.strides
+        shape = (self.nty, self.th // fy, self.ntx, self.tw // fx)
+        need_r = (self.nty - 1) * self.step_y // fy + self.th // fy
+        need_c = (self.ntx - 1) * self.step_x // fx + self.tw // fx
+        if sub.shape[0] < need_r or sub.shape[1] < need_c:
+            raise WallcliError("the video's frame size changed mid-stream; wallcli snr needs a constant size")
+        strides = (self.step_y // fy * rs, rs, self.step_x // fx * cs, cs)
+        return np.lib.stride_tricks.as_strided(sub, shape, strides, writeable=False)
+
+
+# ---------------------------------------------------------------------------------- results
+@dataclass
+class ScaleStats:
+    block: int
+    signal_power: np.ndarray  # (3,)
+    noise_power: np.ndarray  # (3,)
+    blocks: int  # blocks the average ran over
+
+    @property
+    def snr_db(self) -> np.ndarray:
+        return snr_db(self.signal_power, self.noise_power)
+
+
+SNR_DB_LIMIT = 99.0
+
+
+def snr_db(signal, noise) -> np.ndarray:
+    """10 log10(signal / noise), clipped to +-99 dB so the contract's fields stay numbers.
+
+    -99 means no detectable signal (the estimated signal power is <= 0, which the estimator
+    gives when frame-to-frame noise explains all the variance); +99 means no measurable noise
+    (only in synthetic, noise-free video).
+    """
+    s = np.asarray(signal, np.float64)
+    n = np.asarray(noise, np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = 10.0 * np.log10(np.maximum(s, 0.0) / n)
+    out = np.where(s <= 0, -SNR_DB_LIMIT, out)
+    return np.clip(np.nan_to_num(out, nan=-SNR_DB_LIMIT), -SNR_DB_LIMIT, SNR_DB_LIMIT)
+
+
+@dataclass
+class SnrResult:
+    frames: int
+    roi: Roi
+    scales: list[ScaleStats]
+    sampled_pixels: int
+    exact: bool
+    warnings: list[str] = field(default_factory=list)
+
+    def scale(self, block: int) -> ScaleStats:
+        return next(s for s in self.scales if s.block == block)
+
+
+def powers_from_sums(s1, s2, sd, dsum, frames: int, area: float, axes) -> tuple[np.ndarray, np.ndarray]:
+    """Signal and noise power averaged over ``axes`` from per-block sums of centred values.
+
+    s1, s2: sums over time of x and x^2; sd: of squared frame differences; dsum: sum of the
+    differences (= last - first). ``area`` converts block sums to block means (pixels per block).
+    Unbiased variances: T-1 degrees of freedom for values, T-2 for the T-1 differences.
+    """
+    t = float(frames)
+    var_v = (s2 - s1 * s1 / t) / (t - 1.0)
+    var_d = (sd - dsum * dsum / (t - 1.0)) / (t - 2.0)
+    total = var_v.mean(axis=axes) / area**2
+    noise = 0.5 * var_d.mean(axis=axes) / area**2
+    return total - noise, noise
+
+
+# ---------------------------------------------------------------------------------- estimator
+class SnrAccumulator:
+    """Feed decoded frames' planes with :meth:`update`; :meth:`result` gives every block size."""
+
+    def __init__(self, roi: Roi, *, max_pixels: int = DEFAULT_MAX_PIXELS, scales=SCALES):
+        self.roi_requested = roi
+        self.max_pixels = int(max_pixels)
+        self.scales = tuple(scales)
+        self.frames = 0
+        self.warnings: list[str] = []
+
+    def _setup(self, planes) -> None:
+        self.fy, self.fx = footprint(planes)
+        self.roi = snap_roi(self.roi_requested, self.fy, self.fx)
+        if self.roi != tuple(self.roi_requested):
+            self.warnings.append(f"ROI {','.join(map(str, self.roi_requested))} shrunk to "
+                                 f"{','.join(map(str, self.roi))} (whole {self.fx}x{self.fy} chroma samples)")
+        self.lattice = Lattice.plan(self.roi, self.max_pixels)
+        self.m = affine_rgb(planes).astype(np.float32)
+        self.chroma = planes.u is not None
+        lat = self.lattice
+        self.levels = [n for n in self.scales if lat.th // n >= 1 and lat.tw // n >= 1]
+
+    def _rgb(self, planes) -> np.ndarray:
+        """The measured pixels as float32 RGB, shape (3, nty, th, ntx, tw)."""
+        lat, m = self.lattice, self.m
+        y = lat.view(planes.y).astype(np.float32)
+        out = np.empty((3,) + y.shape, np.float32)
+        if not self.chroma:
+            for c in range(3):
+                np.multiply(y, m[c, 0], out=out[c])
+            return out
+        fy, fx = self.fy, self.fx
+        u = lat.view(planes.u, fy, fx).astype(np.float32)
+        v = lat.view(planes.v, fy, fx).astype(np.float32)
+        ny, nx = y.shape[1] // fy, y.shape[3] // fx
+        for c in range(3):
+            o = out[c].reshape(lat.nty, ny, fy, lat.ntx, nx, fx)
+            np.multiply(y.reshape(o.shape), m[c, 0], out=o)
+            # chroma is constant over its footprint: add it once per sample, broadcast
+            o += (m[c, 1] * u + m[c, 2] * v)[:, :, None, :, :, None]
+        return out
+
+    def update(self, planes) -> None:
+        if self.frames == 0:
+            self._setup(planes)
+            x = self._rgb(planes)
+            self.first = x
+            self.prev = x
+            # float32 sums over a chunk of frames (same-type adds cost about half of float32 ->
+            # float64 ones), flushed into float64 totals every CHUNK frames; values are centred on
+            # the first frame, so a chunk's sums are small and keep full precision
+            self.s1 = np.zeros(x.shape, np.float64)
+            self.c1 = np.zeros(x.shape, np.float32)
+            self.s2, self.sd, self.c2, self.cd = {}, {}, {}, {}
+            shape = x.shape
+            for n in self.levels:
+                if n > 1:
+                    shape = (3, shape[1], shape[2] // 2, shape[3], shape[4] // 2)
+                self.s2[n] = np.zeros(shape, np.float64)
+                self.sd[n] = np.zeros(shape, np.float64)
+                self.c2[n] = np.zeros(shape, np.float32)
+                self.cd[n] = np.zeros(shape, np.float32)
+            self._buf = np.empty(x.size, np.float32)
+            self._pending = 0
+            self.frames = 1
+            return
+        x = self._rgb(planes)
+        c = np.subtract(x, self.first)
+        d = np.subtract(x, self.prev)
+        self.prev = x
+        self.c1 += c
+        for n in self.levels:
+            if n > 1:
+                c, d = _halve(c), _halve(d)
+            b = self._buf[: c.size].reshape(c.shape)
+            np.multiply(c, c, out=b)
+            self.c2[n] += b
+            np.multiply(d, d, out=b)
+            self.cd[n] += b
+        self.frames += 1
+        self._pending += 1
+        if self._pending >= CHUNK:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self._pending == 0:
+            return
+        self.s1 += self.c1
+        self.c1.fill(0)
+        for n in self.levels:
+            self.s2[n] += self.c2[n]
+            self.sd[n] += self.cd[n]
+            self.c2[n].fill(0)
+            self.cd[n].fill(0)
+        self._pending = 0
+
+    def result(self) -> SnrResult:
+        if self.frames < MIN_FRAMES:
+            raise WallcliError(f"only {self.frames} frame(s) decoded; the noise estimate needs at least "
+                               f"{MIN_FRAMES} (it compares consecutive frames, over time)")
+        self._flush()
+        s1 = self.s1
+        dsum = (self.prev - self.first).astype(np.float64)
+        scales = []
+        for n in self.levels:
+            if n > 1:
+                s1, dsum = _halve(s1), _halve(dsum)
+            sig, noi = powers_from_sums(s1, self.s2[n], self.sd[n], dsum, self.frames, float(n * n), (1, 2, 3, 4))
+            scales.append(ScaleStats(n, sig, noi, int(np.prod(s1.shape[1:]))))
+        return SnrResult(self.frames, self.roi, scales, self.lattice.pixels, self.lattice.exact, list(self.warnings))
+
+
+# ---------------------------------------------------------------------------------- maps / auto ROI
+def grid_shape(w: int, h: int, long_side: int, fy: int = 1, fx: int = 1) -> tuple[int, int, int, int]:
+    """(rows, cols, cell_h, cell_w): about square cells of whole chroma samples, <= long_side per side."""
+    cell = max(fy, fx, math.ceil(max(w, h) / long_side))
+    ch, cw = -(-cell // fy) * fy, -(-cell // fx) * fx
+    return max(1, h // ch), max(1, w // cw), min(ch, h), min(cw, w)
+
+
+class GridAccumulator:
+    """Signal and noise per cell of a grid over ``roi`` (exact cell means of every pixel), and,
+    with ``covariance``, the temporal covariance of the cells' grey levels for ``--roi auto``."""
+
+    def __init__(self, roi: Roi, long_side: int = 48, *, covariance: bool = False):
+        self.roi_requested = roi
+        self.long_side = long_side
+        self.covariance = covariance
+        self.frames = 0
+
+    def update(self, planes) -> None:
+        if self.frames == 0:
+            fy, fx = footprint(planes)
+            x, y, w, h = snap_roi(self.roi_requested, fy, fx)
+            self.rows, self.cols, self.ch, self.cw = grid_shape(w, h, self.long_side, fy, fx)
+            self.grid_roi = (x, y, self.cols * self.cw, self.rows * self.ch)
+            # background image: the mean luma, on a stride that keeps it about 480 px wide
+            self.bstep = max(1, self.grid_roi[2] // 480)
+        g = rgb_grid(planes, self.grid_roi, self.rows, self.cols)
+        gx, gy, gw, gh = self.grid_roi
+        lum = planes.y[gy:gy + gh:self.bstep, gx:gx + gw:self.bstep]
+        if self.frames == 0:
+            self.first, self.prev = g, g
+            self.s1 = np.zeros_like(g)
+            self.s2 = np.zeros_like(g)
+            self.sd = np.zeros_like(g)
+            self.lum = np.zeros(lum.shape, np.float64)
+            if self.covariance:
+                k = self.rows * self.cols
+                self.c1 = np.zeros(k)
+                self.c2 = np.zeros((k, k))
+                self.cd = np.zeros((k, k))
+        c, d = g - self.first, g - self.prev
+        self.prev = g
+        self.s1 += c
+        self.s2 += c * c
+        self.sd += d * d
+        self.lum += lum
+        if self.covariance:
+            gc, gd = c.mean(axis=2).ravel(), d.mean(axis=2).ravel()
+            self.c1 += gc
+            self.c2 += np.outer(gc, gc)
+            self.cd += np.outer(gd, gd)
+        self.frames += 1
+
+    def _check(self) -> None:
+        if self.frames < MIN_FRAMES:
+            raise WallcliError(f"only {self.frames} frame(s) decoded; the noise estimate needs at least "
+                               f"{MIN_FRAMES} (it compares consecutive frames, over time)")
+
+    def maps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(signal, noise) per cell, each (rows, cols, 3) in code values^2, and the mean luma image."""
+        self._check()
+        dsum = self.prev - self.first
+        sig, noi = powers_from_sums(self.s1, self.s2, self.sd, dsum, self.frames, 1.0, ())
+        return sig, noi, self.lum / self.frames
+
+    def best_roi(self) -> tuple[Roi, float]:
+        """The rectangle of whole cells whose spatially averaged grey level has the highest SNR.
+
+        Var of a rectangle's mean = (sum of the cells' covariances over the rectangle) / n^2, for
+        signal and for frame differences alike; 4-D prefix sums give every rectangle at once.
+        """
+        self._check()
+        t = float(self.frames)
+        dsum = (self.prev - self.first).mean(axis=2).ravel()
+        cov = (self.c2 - np.outer(self.c1, self.c1) / t) / (t - 1.0)
+        covd = (self.cd - np.outer(dsum, dsum) / (t - 1.0)) / (t - 2.0)
+        r, c = self.rows, self.cols
+        y0, y1, x0, x1 = (a.ravel() for a in np.meshgrid(np.arange(r + 1), np.arange(r + 1),
+                                                        np.arange(c + 1), np.arange(c + 1), indexing="ij"))
+        keep = (y1 > y0) & (x1 > x0)
+        y0, y1, x0, x1 = y0[keep], y1[keep], x0[keep], x1[keep]
+        n = ((y1 - y0) * (x1 - x0)).astype(np.float64)
+        total = _rect_quad(cov, r, c, y0, y1, x0, x1) / n**2
+        noise = 0.5 * _rect_quad(covd, r, c, y0, y1, x0, x1) / n**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            snr = np.where(noise > 0, (total - noise) / noise, -np.inf)
+        i = int(np.argmax(snr))
+        gx, gy = self.grid_roi[0], self.grid_roi[1]
+        roi = (gx + int(x0[i]) * self.cw, gy + int(y0[i]) * self.ch,
+               int(x1[i] - x0[i]) * self.cw, int(y1[i] - y0[i]) * self.ch)
+        return roi, float(snr[i])
+
+
+def _rect_quad(m: np.ndarray, r: int, c: int, y0, y1, x0, x1) -> np.ndarray:
+    """For each rectangle: the sum of m[i, j] over cells i and j both inside it."""
+    p = np.zeros((r + 1, c + 1, r + 1, c + 1))
+    p[1:, 1:, 1:, 1:] = m.reshape(r, c, r, c).cumsum(0).cumsum(1).cumsum(2).cumsum(3)
+    out = np.zeros(y0.shape, np.float64)
+    for a, sa in ((y1, 1), (y0, -1)):
+        for b, sb in ((x1, 1), (x0, -1)):
+            for e, se in ((y1, 1), (y0, -1)):
+                for f, sf in ((x1, 1), (x0, -1)):
+                    out += (sa * sb * se * sf) * p[a, b, e, f]
+    return out
+
+
+# ---------------------------------------------------------------------------------- predictor (§3)
+def coverage(radius: float, distance: float, *, approx: bool = False) -> float:
+    """Fraction of the wall point's projected hemisphere a person covers: r^2/(r^2+d^2) exactly
+    for a disk facing the point, A/(pi d^2) = r^2/d^2 in the far-field approximation."""
+    if approx:
+        return radius**2 / distance**2
+    return radius**2 / (radius**2 + distance**2)
+
+
+def predict(*, distance: float, radius: float, albedo: float, contrast: float, occupancy: float,
+            approx: bool = False, mean_code: float | None = None, gain: float | None = None,
+            read_noise: float = 0.0, bits: int = 8, pixels: float = 1.0, frames: float = 1.0) -> dict:
+    """Seed §3.1: signal power q (alpha theta (L_p - L_s))^2 in code values^2.
+
+    Radiances are in code values (what a white wall lit by that radiance alone would record), so
+    alpha * theta * contrast is the change of the wall's code value. With a camera model (mean code
+    value, electrons per 8-bit code value, read noise in electrons, bit depth) the per-pixel noise
+    power is shot mean/gain + (read/gain)^2 + step^2/12 (step = 2^(8-bits) on the 8-bit scale),
+    divided by the pixels and frames averaged (the slow signal survives both averages).
+    """
+    if distance <= 0 or radius <= 0:
+        raise WallcliError("distance and radius must be positive")
+    theta = coverage(radius, distance, approx=approx)
+    amplitude = albedo * theta * contrast
+    out = {"theta": theta, "amplitude": amplitude, "signal_power": occupancy * amplitude**2}
+    if mean_code is not None and gain is not None:
+        if gain <= 0:
+            raise WallcliError("--gain (electrons per code value) must be positive")
+        step = 2.0 ** (8 - bits)
+        shot = max(mean_code, 0.0) / gain
+        read = (read_noise / gain) ** 2
+        quant = step**2 / 12.0
+        noise = (shot + read + quant) / (pixels * frames)
+        out.update({"noise_power": noise, "shot": shot / (pixels * frames), "read": read / (pixels * frames),
+                    "quantisation": quant / (pixels * frames), "snr": out["signal_power"] / noise,
+                    "snr_db": float(snr_db(out["signal_power"], noise))})
+    return out
