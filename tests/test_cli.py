@@ -1,0 +1,45 @@
+"""The CLI's shape: version, help for every command, python -m, usage errors."""
+
+import subprocess
+import sys
+
+import pytest
+
+from wallcli import __version__
+
+COMMANDS = ["stplot", "amplify", "snr", "count", "activity", "simulate", "train"]
+
+
+def test_version_and_module_entry_point():
+    out = subprocess.run([sys.executable, "-m", "wallcli", "--version"], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == f"wallcli {__version__}"
+
+
+def test_help_lists_every_command(run_cli):
+    code, out, _ = run_cli("--help")
+    assert code == 0
+    for name in COMMANDS:
+        assert name in out
+
+
+@pytest.mark.parametrize("name", COMMANDS)
+def test_command_help(run_cli, name):
+    code, out, err = run_cli(name, "--help")
+    assert code == 0, err
+    assert "Usage:" in out and "--help" in out
+
+
+def test_help_does_not_import_heavy_modules():
+    code = (
+        "import sys; from wallcli.cli.app import app; "
+        "heavy = [m for m in ('numpy', 'av', 'cv2', 'onnxruntime', 'matplotlib', 'torch') if m in sys.modules]; "
+        "print(','.join(heavy))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "", out.stdout
+
+
+def test_unknown_option_is_a_one_line_usage_error(run_cli):
+    code, out, err = run_cli("stplot", "x.mp4", "--no-such-option")
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and err.startswith("Error:")
