@@ -1,0 +1,50 @@
+"""`wallcli simulate` end to end: video + sidecar + preview, determinism, usage errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+from wallcli.io.video import open_video
+
+FAST = ["--size", "64x48", "--duration", "0.6", "--fps", "15", "--grid", "8x8"]
+
+
+def _decode(path):
+    with open_video(path) as r:
+        return np.stack([f.planes.rgb() for f in r.frames()])
+
+
+def test_simulate_writes_video_sidecar_preview_and_is_deterministic(tmp_path, run_cli):
+    a, b = tmp_path / "a.mkv", tmp_path / "b.mkv"
+    code, out, err = run_cli("simulate", "-o", a, "--people", "2", "--activity", "walking,crouching",
+                             "--seed", "7", "--preview", tmp_path / "p.png", "--json", *FAST)
+    assert code == 0, err
+    assert json.loads(out)["people"] == 2
+    truth = json.loads(a.with_suffix(".json").read_text())
+    assert {k: truth[k] for k in ("people", "activity", "fps", "frames", "seed")} == \
+        {"people": 2, "activity": "walking", "fps": 15.0, "frames": 9, "seed": 7}
+    assert [len(p["positions"]) for p in truth["persons"]] == [9, 9]
+    assert (tmp_path / "p.png").stat().st_size > 10_000
+    code, out, err = run_cli("simulate", "-o", b, "--people", "2", "--activity", "walking,crouching", "--seed", "7", *FAST)
+    assert code == 0, err
+    assert out == ""  # stdout carries data only, and none was asked for
+    fa, fb = _decode(a), _decode(b)
+    assert fa.shape == (9, 48, 64, 3)
+    np.testing.assert_array_equal(fa, fb)
+    code, _, err = run_cli("simulate", "-o", a, *FAST)  # exists, no --force
+    assert code == 1 and err.startswith("Error:")
+
+
+def test_simulate_flatland_mp4(tmp_path, run_cli):
+    out = tmp_path / "f.mp4"
+    code, _, err = run_cli("simulate", "-o", out, "--world", "flatland", "--people", "1", *FAST)
+    assert code == 0, err
+    assert json.loads(out.with_suffix(".json").read_text())["people"] == 1
+
+
+@pytest.mark.parametrize("args", [["--activity", "dancing"], ["--size", "65x48"], ["--distance", "2,1"],
+                                  ["--world", "mars"], ["--dataset", "4", "--task", "sing"], ["--people", "3"]])
+def test_simulate_usage_errors_exit_2(tmp_path, run_cli, args):
+    code, _, err = run_cli("simulate", "-o", tmp_path / "x.mp4", *args)
+    assert code == 2 and "Error:" in err

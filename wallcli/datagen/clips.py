@@ -1,0 +1,105 @@
+"""One training scene: sample -> render -> encode a real video file -> the real stplot path -> windows.
+
+The windows go through exactly the code real videos go through (``open_video`` ->
+``compute_stplot`` -> ``resample``), including the codec, chroma subsampling and the reader's
+colour conversion, so the model never sees a shortcut that only simulations have.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from wallcli.sim.camera import video_pix_fmt
+from wallcli.sim.motion import ACTIVITIES
+from wallcli.sim.scene import SceneConfig, sample_scene
+from wallcli.sim.world_flat import sample_flat_scene
+
+WINDOW, FPS, BINS = 256, 30.0, 64
+# Class mixes. Count: every activity appears (a crouching person is one person) and two people
+# mix activities independently; standing people count too but are rarer (they are near-invisible).
+COUNT_ACTS = (["none", "walking", "crouching", "waving", "jumping"], [0.08, 0.44, 0.16, 0.16, 0.16])
+
+
+def scene_plan(rng: np.random.Generator, task: str) -> tuple[int, list[str], int]:
+    """(people, activities, label) for one scene, balanced over the task's classes."""
+    if task == "count":
+        n = int(rng.integers(0, 3))
+        acts = [str(rng.choice(COUNT_ACTS[0], p=COUNT_ACTS[1])) for _ in range(n)]
+        return n, acts, n
+    label = int(rng.integers(0, len(ACTIVITIES)))
+    act = ACTIVITIES[label]
+    if act == "none":  # nobody, or someone standing still
+        n = int(rng.random() < 0.5)
+        return n, ["none"] * n, label
+    return 1, [act], label
+
+
+def _window_starts(length: int, k: int, rng) -> list[int]:
+    """k window starts spread over the clip (overlapping when the clip is short), jittered."""
+    span = length - WINDOW
+    if span < 0:
+        return []
+    base = np.linspace(0, span, k)
+    jitter = rng.uniform(-0.5, 0.5, k) * (span / max(k, 1))
+    return sorted(int(v) for v in np.clip(np.rint(base + jitter), 0, span))
+
+
+def render_windows(seed: int, index: int, task: str, *, domain: str = "base", world: str = "room",
+                   windows: int = 3, grid: tuple[int, int] = (24, 32), tmpdir: str | None = None,
+                   camera_overrides: dict | None = None) -> dict:
+    """All windows of scene ``index``: arrays (k, BINS, WINDOW, 3) + labels + the scene's parameters."""
+    from wallcli.io.video import open_video
+    from wallcli.io.writer import VideoWriter
+    from wallcli.signal.stplot import compute_stplot
+    from wallcli.signal.window import resample
+
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), int(index), 7]))
+    people, acts, label = scene_plan(rng, task)
+    if world == "mixed":
+        world = "flatland" if (task == "count" and rng.random() < 0.25) else "room"
+    duration = WINDOW / FPS + rng.uniform(1.5, 6.0)
+    if world == "flatland":
+        if task != "count":
+            raise ValueError("flatland has no activities; use it for the count task")
+        scene = sample_flat_scene(seed, index, people, duration=duration, domain=domain)
+        for k, v in (camera_overrides or {}).items():
+            setattr(scene.camera, k, v)
+        acts = ["walking"] * people
+    else:
+        cfg = SceneConfig(people=people, activities=acts or None, duration=duration, grid=grid, domain=domain,
+                          camera_overrides=dict(camera_overrides or {}))
+        scene = sample_scene(seed, cfg, index=index)
+    cam = scene.camera
+    suffix = ".mkv" if cam.codec == "ffv1" else ".mp4"
+    fd, name = tempfile.mkstemp(suffix=suffix, dir=tmpdir)
+    os.close(fd)
+    path = Path(name)
+    try:
+        with VideoWriter(path, cam.fps, cam.width, cam.height, codec=cam.codec, crf=cam.crf,
+                         pix_fmt=video_pix_fmt(cam), preset="veryfast") as w:
+            for frame in scene.frames():
+                w.write(frame)
+        with open_video(path) as reader:
+            plot = compute_stplot(reader, bins=BINS)
+    finally:
+        path.unlink(missing_ok=True)
+    h, t = resample(plot.horizontal, plot.time, FPS)
+    v, _ = resample(plot.vertical, plot.time, FPS)
+    starts = _window_starts(h.shape[1], windows, rng)
+    truth = scene.truth()
+    meta = {k: truth[k] for k in ("people", "activity", "activities", "fps", "frames", "width", "height", "domain")}
+    meta.update(seed=int(seed), index=int(index), world=world, camera=truth["camera"],
+                room=truth.get("room"), distance_m=[round(float(np.median(np.array(p["positions"])[:, 1])), 2) for p in truth["persons"]])
+    activity = ACTIVITIES.index(truth["activity"])
+    return {
+        "horizontal": np.stack([h[:, s : s + WINDOW] for s in starts]).astype(np.float32),
+        "vertical": np.stack([v[:, s : s + WINDOW] for s in starts]).astype(np.float32),
+        "label": np.full(len(starts), label, np.int64),
+        "people": np.full(len(starts), len(acts), np.int64),
+        "activity": np.full(len(starts), activity, np.int64),
+        "scenes": [dict(meta, window_start_s=round(s / FPS, 3)) for s in starts],
+    }

@@ -1,0 +1,429 @@
+"""A box room lit by lamps and windows, and the light that bodies of spheres take from a wall.
+
+Model (units arbitrary but consistent; a uniform surround of radiance L gives E = pi L):
+- Surfaces 0..4 (left x=0, right x=W, back y=D, floor z=0, ceiling z=H) are Lambertian with
+  albedo textures. Their radiance is rho * (E_direct + E_ambient) / pi; E_direct comes from the
+  lamps (small emitting spheres, exact sphere form factor), E_ambient is the closed-box radiosity
+  estimate rho_mean * flux / (area * (1 - rho_mean)) that stands in for all further bounces.
+  Windows are emitting rectangles painted into the wall radiance maps.
+- The observed wall (y = 0) receives E_static(x) = lamps (exact sphere form factors) + the five
+  surfaces, integrated as piecewise-constant patches with exact polygon form factors (Lambert).
+- Bodies are spheres. Each changes a wall point's irradiance by exactly
+  pi * (r/D)^2 cos(beta) * (L_body - L_behind) when the background behind it is uniform over its
+  angular disc; L_behind is the radiance of the room surface hit by the ray through the sphere's
+  centre, looked up on radiance maps blurred by ~15 cm (approximation: the mean behind the disc).
+  Lamps behind a sphere are occluded by the planar-disc overlap of the two angular discs
+  (small-angle approximation, < 1 % for discs under 15 degrees), which gives soft shadows.
+- Approximations, documented: where two spheres overlap as seen from a wall point (along a
+  torso, an arm in front of the body, one person behind another) the farther one's hidden part
+  is removed (angular-disc overlap; several hiders combine as independent; computed on a 5 x 5
+  sub-grid of the wall and interpolated; whole bodies match brute-force ray casting within ~2.5 %
+  at 1 m, see tests/sim/test_physics.py); bodies do not shadow
+  the other room surfaces (a second-order effect on the observed wall); body radiance uses one
+  view direction (to the centre of the observed patch) and ambient + lamp light without
+  self-shadowing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wallcli.sim.geometry import disc_overlap, lambert_sphere_phase, polygon_form_factor
+
+NORMALS = np.array([[1, 0, 0], [-1, 0, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], float)
+TEX = 48  # radiance-map texels per surface side
+PATCHES = 8  # patches per surface side for the static irradiance integral
+
+
+@dataclass
+class Room:
+    size: np.ndarray  # (W, D, H) metres
+    albedo: np.ndarray  # (5, TEX, TEX, 3) surface albedo maps, [surface, v, u]
+    radiance: np.ndarray  # (5, TEX, TEX, 3) surface radiance maps (windows included)
+    lamp_pos: np.ndarray  # (K, 3)
+    lamp_radius: np.ndarray  # (K,)
+    lamp_radiance: np.ndarray  # (K, 3)
+    ambient: np.ndarray  # (3,) ambient irradiance used for bodies and surfaces
+    windows: list = field(default_factory=list)  # [(surface, u0, u1, v0, v1)] for previews
+    radiance_blur: np.ndarray = None  # radiance maps blurred by ~15 cm: the mean behind a body sphere
+
+    def __post_init__(self):
+        if self.radiance_blur is None:
+            self.radiance = self.radiance.astype(np.float32)
+            self.radiance_blur = _blur(self.radiance, max(1, int(round(0.15 / (self.size.max() / TEX)))))
+
+    @property
+    def lamp_intensity(self) -> np.ndarray:
+        return self.lamp_radiance * (np.pi * self.lamp_radius**2)[:, None]
+
+
+def _blur(maps: np.ndarray, k: int) -> np.ndarray:
+    """Box blur (2k+1 texels) of each surface map, edges clamped."""
+    out = maps.copy()
+    for axis in (1, 2):
+        pad = [(0, 0)] * 4
+        pad[axis] = (k, k)
+        c = np.cumsum(np.pad(out, pad, mode="edge"), axis=axis, dtype=np.float64)
+        c = np.concatenate([np.zeros_like(np.take(c, [0], axis=axis)), c], axis=axis)
+        n = out.shape[axis]
+        out = ((np.take(c, np.arange(2 * k + 1, n + 2 * k + 1), axis=axis) - np.take(c, np.arange(n), axis=axis)) / (2 * k + 1)).astype(np.float32)
+    return out
+
+
+def surface_uv_to_xyz(size: np.ndarray, s: int, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    W, D, H = size
+    u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+    z0 = np.zeros(u.shape)
+    if s == 0:
+        return np.stack([z0, u * D, v * H], -1)
+    if s == 1:
+        return np.stack([z0 + W, u * D, v * H], -1)
+    if s == 2:
+        return np.stack([u * W, z0 + D, v * H], -1)
+    if s == 3:
+        return np.stack([u * W, v * D, z0], -1)
+    return np.stack([u * W, v * D, z0 + H], -1)
+
+
+def _smooth_field(rng, n: int, octaves: int = 3) -> np.ndarray:
+    """Zero-mean random field on an n x n grid from a few low-frequency cosines."""
+    y, x = np.mgrid[0:n, 0:n] / n
+    f = np.zeros((n, n))
+    for k in range(octaves):
+        for _ in range(3):
+            fx, fy = rng.uniform(0.5, 2.5) * 2**k, rng.uniform(0.5, 2.5) * 2**k
+            f += np.cos(2 * np.pi * (fx * x + fy * y) + rng.uniform(0, 2 * np.pi)) / 2**k
+    return f / (np.abs(f).max() + 1e-9)
+
+
+def _paint(rng, lo: float, hi: float, tint: float) -> np.ndarray:
+    base = rng.uniform(lo, hi)
+    return np.clip(base * (1 + rng.uniform(-tint, tint, 3)), 0.02, 0.95)
+
+
+def sample_room(rng: np.random.Generator, domain: str = "base") -> Room:
+    """A random furnished box room. ``domain='shifted'`` moves every range (held-out validation)."""
+    shifted = domain == "shifted"
+    W = rng.uniform(5.5, 9.0) if shifted else rng.uniform(3.0, 7.0)
+    D = rng.uniform(6.0, 9.5) if shifted else rng.uniform(4.5, 8.0)
+    H = rng.uniform(2.9, 3.8) if shifted else rng.uniform(2.4, 3.1)
+    size = np.array([W, D, H])
+    albedo = np.empty((5, TEX, TEX, 3))
+    wall_paint = _paint(rng, 0.25, 0.6, 0.25) if shifted else _paint(rng, 0.4, 0.9, 0.15)
+    for s in range(5):
+        paint = wall_paint if s < 3 else (_paint(rng, 0.1, 0.5, 0.3) if s == 3 else _paint(rng, 0.6, 0.9, 0.05))
+        if s < 3 and rng.random() < 0.3:
+            paint = _paint(rng, 0.1, 0.9, 0.5)  # an accent wall
+        var = rng.uniform(0.02, 0.25 if s == 3 else 0.12)
+        albedo[s] = paint * (1 + var * _smooth_field(rng, TEX))[..., None]
+        for _ in range(rng.integers(0, 5)):  # furniture, pictures, rugs: coloured rectangles
+            u0, v0 = rng.uniform(0, 0.85, 2)
+            du, dv = rng.uniform(0.05, 0.4, 2)
+            iu, iv = (np.array([u0, u0 + du]) * TEX).astype(int), (np.array([v0, v0 + dv]) * TEX).astype(int)
+            if s < 3:  # furniture stands on the floor
+                iv = iv - iv[0] if rng.random() < 0.6 else iv
+            albedo[s, iv[0] : iv[1], iu[0] : iu[1]] = _paint(rng, 0.03, 0.8, 0.6)
+    albedo = np.clip(albedo, 0.02, 0.95)
+
+    n_lamps = int(rng.integers(0, 5 if shifted else 4))
+    n_windows = int(rng.integers(0, 3))
+    if n_lamps + n_windows == 0:
+        n_lamps = 1
+    lamp_pos, lamp_radius, lamp_rad = [], [], []
+    for _ in range(n_lamps):
+        kind = rng.random()
+        a = rng.uniform(0.03, 0.2)
+        if kind < 0.5:  # ceiling lamp
+            z = H - rng.uniform(0.1, 0.6)
+        elif kind < 0.8:  # floor lamp
+            z = rng.uniform(1.2, 1.9)
+        else:  # desk lamp
+            z = rng.uniform(0.6, 1.1)
+        pos = np.array([rng.uniform(0.3, W - 0.3), rng.uniform(0.4, D - 0.3), min(z, H - a - 0.02)])
+        if kind >= 0.5:  # standing lamps stand by a side or back wall, out of the walkers' way
+            side = rng.integers(0, 3)
+            if side < 2:
+                pos[0] = rng.uniform(0.15, 0.35) if side == 0 else W - rng.uniform(0.15, 0.35)
+            else:
+                pos[1] = D - rng.uniform(0.15, 0.35)
+        temp = rng.uniform(0, 1)  # warm .. cool white
+        colour = np.array([1.0, 0.72 + 0.25 * temp, 0.45 + 0.55 * temp]) * (1 + rng.uniform(-0.05, 0.05, 3))
+        intensity = rng.uniform(15, 300) * (0.5 if shifted else 1.0)
+        lamp_pos.append(pos)
+        lamp_radius.append(a)
+        lamp_rad.append(colour * intensity / (np.pi * a * a))
+    lamp_pos = np.array(lamp_pos).reshape(-1, 3)
+    lamp_radius = np.array(lamp_radius, float)
+    lamp_rad = np.array(lamp_rad).reshape(-1, 3)
+
+    # Surface irradiance: direct lamp light + closed-box ambient estimate.
+    vv, uu = (np.mgrid[0:TEX, 0:TEX] + 0.5) / TEX
+    direct = np.zeros((5, TEX, TEX, 3))
+    area = np.array([D * H, D * H, W * H, W * D, W * D])
+    for s in range(5):
+        p = surface_uv_to_xyz(size, s, uu, vv)
+        for k in range(len(lamp_radius)):
+            d = lamp_pos[k] - p
+            r2 = np.einsum("...k,...k", d, d)
+            cos = np.clip(d @ NORMALS[s] / np.sqrt(r2), 0, None)
+            direct[s] += (np.pi * lamp_rad[k] * (lamp_radius[k] ** 2 / r2 * cos)[..., None])
+    windows, window_flux = [], np.zeros(3)
+    sky = np.array([0.85, 0.93, 1.0]) * (1 + rng.uniform(-0.08, 0.08, 3))
+    window_mask = np.zeros((5, TEX, TEX), bool)
+    window_rad = np.zeros((5, TEX, TEX, 3))
+    for _ in range(n_windows):
+        s = int(rng.integers(0, 3))
+        wu, wv = rng.uniform(0.15, 0.45), rng.uniform(0.3, 0.55)
+        u0, v0 = rng.uniform(0.05, 0.95 - wu), rng.uniform(0.25, 0.95 - wv)
+        L = rng.uniform(3, 60) * sky
+        iu = slice(int(u0 * TEX), int((u0 + wu) * TEX))
+        iv = slice(int(v0 * TEX), int((v0 + wv) * TEX))
+        grad = 1 + rng.uniform(-0.2, 0.2) * (vv[iv, iu] - v0) / wv
+        window_mask[s, iv, iu] = True
+        window_rad[s, iv, iu] = L * grad[..., None]
+        window_flux += np.pi * L * (wu * wv * area[s])
+        windows.append((s, u0, u0 + wu, v0, v0 + wv))
+    rho_mean = float(np.average(albedo.mean(axis=(1, 2, 3)), weights=area))
+    lamp_flux = 4 * np.pi * (lamp_rad * (np.pi * lamp_radius**2)[:, None]).sum(axis=0)
+    ambient = rho_mean * (lamp_flux + window_flux) / (area.sum() + W * H) / (1 - rho_mean)
+    radiance = albedo * (direct + ambient) / np.pi
+    radiance[window_mask] = window_rad[window_mask]
+    return Room(size, albedo, radiance, lamp_pos, lamp_radius, lamp_rad, ambient, windows)
+
+
+def uniform_room(size=(5.0, 5.0, 3.0), radiance=(1.0, 1.0, 1.0)) -> Room:
+    """A room of uniform radiance and no lamps: the test bed for the analytic checks."""
+    L = np.asarray(radiance, float)
+    rad = np.broadcast_to(L, (5, TEX, TEX, 3)).copy()
+    return Room(np.asarray(size, float), np.full((5, TEX, TEX, 3), 0.5), rad, np.zeros((0, 3)),
+                np.zeros(0), np.zeros((0, 3)), np.pi * L)
+
+
+def _patches(room: Room):
+    """Corner polygons (S*P*P, 4, 3), normals and mean radiance of every surface patch."""
+    P = PATCHES
+    g = np.linspace(0, 1, P + 1)
+    polys, normals, rad = [], [], []
+    pooled = room.radiance.reshape(5, P, TEX // P, P, TEX // P, 3).mean(axis=(2, 4))
+    for s in range(5):
+        for j in range(P):
+            for i in range(P):
+                u = np.array([g[i], g[i + 1], g[i + 1], g[i]])
+                v = np.array([g[j], g[j], g[j + 1], g[j + 1]])
+                polys.append(surface_uv_to_xyz(room.size, s, u, v))
+                normals.append(NORMALS[s])
+                rad.append(pooled[s, j, i])
+    return np.array(polys), np.array(normals), np.array(rad)
+
+
+def static_irradiance(room: Room, points: np.ndarray, chunk: int = 256) -> np.ndarray:
+    """Irradiance (N, 3) at points on the wall y = 0 from the empty room."""
+    polys, _, rad = _patches(room)
+    wall_n = np.array([0.0, 1.0, 0.0])
+    out = np.zeros((len(points), 3))
+    for i in range(0, len(points), chunk):
+        F = polygon_form_factor(points[i : i + chunk], wall_n, polys)
+        out[i : i + chunk] = np.pi * F @ rad
+    for k in range(len(room.lamp_radius)):
+        d = room.lamp_pos[k] - points
+        r2 = np.einsum("nk,nk->n", d, d)
+        out += np.pi * room.lamp_radiance[k] * (room.lamp_radius[k] ** 2 * d[:, 1] / r2**1.5)[:, None]
+    return out
+
+
+def background_radiance(room: Room, points: np.ndarray, dirs: np.ndarray, blurred: bool = False) -> np.ndarray:
+    """Radiance of the room surface hit by rays from wall points (..., 3) along dirs (..., 3) (dir_y > 0)."""
+    p, d = np.broadcast_arrays(points, dirs)
+    return _bg_lookup(room, p[..., 0], p[..., 2], d[..., 0], d[..., 1], d[..., 2], blurred)
+
+
+def _bg_lookup(room, px, pz, dx, dy, dz, blurred):
+    """Ray-box exit for rays from the wall y = 0, then a nearest-texel lookup of the hit surface."""
+    W, D, H = (float(v) for v in room.size)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_x = 1.0 / dx
+        inv_z = 1.0 / dz
+        tx = np.where(dx > 0, W - px, -px) * inv_x
+        tz = np.where(dz > 0, H - pz, -pz) * inv_z
+        ty = D / dy
+    tx[~np.isfinite(tx)] = np.inf
+    tz[~np.isfinite(tz)] = np.inf
+    side_x = tx < tz
+    t_side = np.where(side_x, tx, tz)
+    back = ty <= t_side
+    t = np.where(back, ty, t_side)
+    hx, hy, hz = px + t * dx, t * dy, pz + t * dz
+    # surface index: 2 back; else 0/1 side walls by sign of dx; else 3/4 floor/ceiling by sign of dz
+    s = np.where(back, 2, np.where(side_x, (dx > 0).astype(np.int8), 3 + (dz > 0)))
+    u = np.where(s <= 1, hy * (TEX / D), hx * (TEX / W))
+    v = np.where(s <= 2, hz * (TEX / H), hy * (TEX / D))
+    iu = np.clip(u.astype(np.intp), 0, TEX - 1)
+    iv = np.clip(v.astype(np.intp), 0, TEX - 1)
+    return (room.radiance_blur if blurred else room.radiance)[s, iv, iu]
+
+
+def body_radiance(room: Room, centers: np.ndarray, albedo: np.ndarray, view: np.ndarray) -> np.ndarray:
+    """Mean radiance (M, 3) of Lambertian spheres seen from ``view`` (a point on the wall)."""
+    L = np.broadcast_to(room.ambient, albedo.shape) / np.pi
+    L = L.copy()
+    to_view = view - centers
+    to_view /= np.linalg.norm(to_view, axis=-1, keepdims=True)
+    for k in range(len(room.lamp_radius)):
+        d = room.lamp_pos[k] - centers
+        r2 = np.einsum("mk,mk->m", d, d)
+        cos_a = np.einsum("mk,mk->m", d, to_view) / np.sqrt(r2)
+        e = np.pi * room.lamp_radiance[k][None] * (room.lamp_radius[k] ** 2 / r2 * lambert_sphere_phase(np.arccos(np.clip(cos_a, -1, 1))))[:, None]
+        L += e / np.pi
+    return albedo * L
+
+
+def body_delta(room: Room, points: np.ndarray, centers: np.ndarray, radii: np.ndarray,
+               L_body: np.ndarray, bbox: tuple | None = None, pairs: np.ndarray | None = None) -> np.ndarray:
+    """Change of irradiance (..., 3) at wall points (..., 3) caused by spheres (module docstring).
+
+    Form factors are exact at every point; the background behind a sphere is looked up on the
+    blurred radiance maps, standing in for its mean over the sphere's angular disc.
+    ``pairs`` (P, 2) lists sphere pairs that may overlap as seen from the wall (``overlapping_pairs``):
+    the part of the farther sphere's angular disc that the nearer one covers is removed
+    (angular-disc overlap; several hiders combine as independent, see _pair_overlap).
+    """
+    shape = points.shape[:-1]
+    flat = points.reshape(-1, 3)
+    if len(radii) == 0:
+        return np.zeros(shape + (3,))
+    if bbox is None:
+        bbox = (flat[:, 0].min(), flat[:, 0].max(), flat[:, 2].min(), flat[:, 2].max())
+    hidden = None
+    if pairs is not None and len(pairs):
+        if points.ndim == 3 and min(shape) > 5:
+            # occlusion between spheres changes slowly along the wall (parallax): exact on a 5 x 5
+            # sub-grid, interpolated linearly in between
+            iy = np.linspace(0, shape[0] - 1, 5).round().astype(int)
+            ix = np.linspace(0, shape[1] - 1, 5).round().astype(int)
+            h = hidden_fraction(points[np.ix_(iy, ix)].reshape(-1, 3), centers, radii, np.asarray(pairs))
+            h = (index_interp(shape[0], iy) @ h.reshape(5, -1)).reshape(shape[0], 5, -1)
+            h = np.matmul(index_interp(shape[1], ix)[None], h)  # (gy, gx, M)
+            hidden = h.reshape(len(flat), -1)
+        else:
+            hidden = hidden_fraction(flat, centers, radii, np.asarray(pairs))
+    chunk = 768  # keeps the (points, spheres) temporaries in cache
+    out = np.concatenate([_delta_flat(room, flat[i : i + chunk], centers, radii, L_body, bbox,
+                                      None if hidden is None else hidden[i : i + chunk])
+                          for i in range(0, len(flat), chunk)])
+    return out.reshape(shape + (3,))
+
+
+def _delta_flat(room, flat, centers, radii, L_body, bbox, hidden=None):
+    # float32 is ample here: these are the small terms themselves, not differences of large ones
+    c = centers.astype(np.float32)
+    f = flat.astype(np.float32)
+    vx = c[None, :, 0] - f[:, 0:1]
+    vy = c[None, :, 1] - f[:, 1:2]
+    vz = c[None, :, 2] - f[:, 2:3]
+    d2 = vx * vx + vy * vy + vz * vz
+    dist = np.sqrt(d2)
+    inv = 1.0 / dist
+    F = (radii[None, :] ** 2).astype(np.float32) * vy * inv / d2
+    if hidden is not None:
+        F = F * (1 - hidden).astype(np.float32)  # the parts hidden behind nearer spheres
+    L_bg = _bg_lookup(room, f[:, 0:1], f[:, 2:3], vx * inv, vy * inv, vz * inv, True)
+    dE = np.pi * (F @ L_body - np.einsum("nm,nmc->nc", F, L_bg))
+    if len(room.lamp_radius):
+        dE -= _lamp_occlusion(room, flat, centers, radii, (vx, vy, vz), dist, L_bg, bbox)
+    return dE
+
+
+def overlapping_pairs(probes: np.ndarray, centers: np.ndarray, radii: np.ndarray, margin: float = 1.25) -> np.ndarray:
+    """Sphere pairs (P, 2) whose angular discs overlap (or nearly, x margin) seen from any probe
+    point: candidates for the pair correction of body_delta. Probes: a few wall points spanning
+    the observed region (parallax between them is small, the margin covers it)."""
+    v = centers[None] - probes[:, None]  # (K, M, 3)
+    dist = np.linalg.norm(v, axis=-1)
+    u = v / dist[..., None]
+    sig = np.arcsin(np.clip(radii[None] / dist, 0, 1))
+    cos_g = np.einsum("kmc,knc->kmn", u, u)
+    lim = np.cos(np.minimum(margin * (sig[:, :, None] + sig[:, None, :]), np.pi))
+    close = (cos_g > lim).any(axis=0)
+    a, b = np.nonzero(np.triu(close, 1))
+    return np.stack([a, b], -1)
+
+
+def hidden_fraction(points: np.ndarray, centers: np.ndarray, radii: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """(N, M) fraction of each sphere's angular disc hidden behind nearer spheres, seen from points.
+
+    For every pair the nearer sphere hides the fraction f = overlap / disc of the farther one;
+    a sphere hidden by several nearer ones keeps prod(1 - f) of its disc (the hiders' overlaps
+    are treated as independent, which is exact for one hider and bounded for more)."""
+    v = centers[None] - points[:, None]
+    dist = np.linalg.norm(v, axis=-1)
+    u = v / dist[..., None]
+    sig = np.arcsin(np.clip(radii[None] / dist, 0, 1))
+    a, b = pairs[:, 0], pairs[:, 1]
+    cos_g = np.einsum("npc,npc->np", u[:, a], u[:, b])
+    sa, sb = sig[:, a], sig[:, b]
+    omega = disc_overlap(sa, sb, np.arccos(np.clip(cos_g, -1, 1)))
+    a_far = dist[:, a] > dist[:, b]
+    s_far = np.where(a_far, sa, sb)
+    far = np.where(a_far, a[None], b[None])
+    frac = np.clip(omega / (np.pi * s_far * s_far), 0, 1 - 1e-9)
+    keep_log = np.zeros(dist.size)
+    np.add.at(keep_log, (np.arange(len(points))[:, None] * dist.shape[1] + far).ravel(), np.log1p(-frac).ravel())
+    return -np.expm1(keep_log.reshape(dist.shape))
+
+
+def index_interp(n: int, idx: np.ndarray) -> np.ndarray:
+    """(n, len(idx)) linear interpolation weights from samples at sorted integer positions idx."""
+    A = np.zeros((n, len(idx)))
+    if len(idx) == 1:
+        A[:, 0] = 1
+        return A
+    for r in range(n):
+        k = min(np.searchsorted(idx, r, side="right") - 1, len(idx) - 2)
+        w = (r - idx[k]) / (idx[k + 1] - idx[k])
+        A[r, k], A[r, k + 1] = 1 - w, w
+    return A
+
+
+def _lamp_occlusion(room, points, centers, radii, u, dist, L_bg, bbox):
+    """Irradiance removed where spheres cover part of a lamp's angular disc (soft shadows)."""
+    out = np.zeros((len(points), 3))
+    x0, x1, z0, z1 = bbox
+    for k in range(len(room.lamp_radius)):
+        lp, a = room.lamp_pos[k], room.lamp_radius[k]
+        cy = centers[:, 1]
+        ok = cy + radii < lp[1] - a
+        t = lp[1] / np.maximum(lp[1] - cy, 1e-9)
+        sx = lp[0] + (centers[:, 0] - lp[0]) * t
+        sz = lp[2] + (centers[:, 2] - lp[2]) * t
+        reach = 1.3 * (radii * t + a * (t - 1)) + 0.05
+        ok &= (sx + reach > x0) & (sx - reach < x1) & (sz + reach > z0) & (sz - reach < z1)
+        js = np.flatnonzero(ok)
+        if js.size == 0:
+            continue
+        w = lp - points
+        R = np.linalg.norm(w, axis=-1)
+        w /= R[:, None]
+        vx, vy, vz = u
+        cos_g = (vx[:, js] * w[:, 0:1] + vy[:, js] * w[:, 1:2] + vz[:, js] * w[:, 2:3]) / dist[:, js]
+        sig = np.arcsin(np.clip(radii[js][None] / dist[:, js], 0, 1))
+        lam = np.arcsin(np.clip(a / R, 0, 1))[:, None]
+        # only (point, sphere) pairs whose discs can touch, and where the sphere is nearer than the lamp
+        near = (cos_g > np.cos(np.minimum(sig + lam, np.pi))) & (dist[:, js] < R[:, None])
+        n_i, j_i = np.nonzero(near)
+        if n_i.size == 0:
+            continue
+        gamma = np.arccos(np.clip(cos_g[n_i, j_i], -1, 1))
+        lam_n = lam[n_i, 0]
+        frac = np.clip(disc_overlap(sig[n_i, j_i], lam_n, gamma) / (np.pi * lam_n * lam_n), 0, 1 - 1e-9)
+        # several spheres over one lamp: the lamp keeps prod(1 - f) (not 1 - sum f, which could go negative)
+        s_frac = np.zeros(len(points))
+        s_log = np.zeros(len(points))
+        np.add.at(s_frac, n_i, frac)
+        np.add.at(s_log, n_i, np.log1p(-frac))
+        scale = -np.expm1(s_log[n_i]) / np.maximum(s_frac[n_i], 1e-12)
+        omega = frac * scale * (np.pi * lam_n * lam_n) * w[n_i, 1]
+        contrast = room.lamp_radiance[k][None, :] - L_bg[n_i, js[j_i]]
+        np.add.at(out, n_i, omega[:, None] * contrast)
+    return out
