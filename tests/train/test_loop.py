@@ -1,5 +1,3 @@
-import json
-
 import numpy as np
 import pytest
 
@@ -8,7 +6,7 @@ torch = pytest.importorskip("torch")
 from wallcli.errors import WallcliError  # noqa: E402
 from wallcli.train.augment import augment  # noqa: E402
 from wallcli.train.data import ShardDataset, split_validation  # noqa: E402
-from wallcli.train.loop import TrainConfig, evaluate, train  # noqa: E402
+from wallcli.train.loop import TrainConfig, train  # noqa: E402
 
 
 def test_dataset_plan_covers_indices_once(make_dataset):
@@ -60,19 +58,11 @@ def test_two_epochs_reduce_loss_and_checkpoint(make_dataset, tmp_path):
     data = make_dataset("count", 64)
     cfg = _cfg(tmp_path, data)
     events = []
-    torch.manual_seed(0)
     res = train(cfg, lambda kind, **f: events.append((kind, f)))
     assert [h["epoch"] for h in res["history"]] == [1, 2]
     assert cfg.checkpoint_path().is_file()
-    ds = res["dataset"]
-    tr, _ = split_validation(ds.n, cfg.val_fraction, cfg.seed)
-    from wallcli.train.nets import build
-
-    torch.manual_seed(cfg.seed)
-    fresh = build("count").to(memory_format=torch.channels_last)  # same init as the run
-    before = evaluate(fresh, ds, tr, 32)["loss"]
-    after = evaluate(res["net"], ds, tr, 32)["loss"]
-    assert after < before
+    # training-mode loss (what the optimiser sees) falls from epoch 1 to epoch 2
+    assert res["history"][1]["train_loss"] < 0.9 * res["history"][0]["train_loss"], res["history"]
     kinds = [k for k, _ in events]
     assert kinds.count("epoch_end") == 2 and "step" in kinds and "checkpoint" in kinds
     v = res["validation"]
@@ -80,14 +70,14 @@ def test_two_epochs_reduce_loss_and_checkpoint(make_dataset, tmp_path):
 
 
 def test_interrupted_run_resumes_exactly(make_dataset, tmp_path):
-    data = make_dataset("count", 40)
-    straight = train(_cfg(tmp_path, data, out=tmp_path / "a.onnx", epochs=2))
+    data = make_dataset("count", 28)
+    straight = train(_cfg(tmp_path, data, out=tmp_path / "a.onnx", epochs=2, batch_size=8))
 
     def stop_after_two_steps(kind, **f):
         if kind == "step" and f["epoch"] == 1 and f["batch"] == 1:
             raise KeyboardInterrupt
 
-    cfg = _cfg(tmp_path, data, out=tmp_path / "b.onnx", epochs=2)
+    cfg = _cfg(tmp_path, data, out=tmp_path / "b.onnx", epochs=2, batch_size=8)
     with pytest.raises(KeyboardInterrupt):
         train(cfg, stop_after_two_steps)
     ck = torch.load(cfg.checkpoint_path(), weights_only=False)
@@ -101,8 +91,18 @@ def test_interrupted_run_resumes_exactly(make_dataset, tmp_path):
 
 
 def test_checkpoint_of_another_run_is_refused(make_dataset, tmp_path):
-    data = make_dataset("count", 24)
-    cfg = _cfg(tmp_path, data, epochs=1)
+    data = make_dataset("count", 12)
+    cfg = _cfg(tmp_path, data, epochs=1, batch_size=8)
     train(cfg)
     with pytest.raises(WallcliError, match="different run"):
-        train(_cfg(tmp_path, data, epochs=1, seed=7))
+        train(_cfg(tmp_path, data, epochs=1, batch_size=8, seed=7))
+
+
+def test_checkpoints_within_an_epoch_on_a_timer(make_dataset, tmp_path):
+    data = make_dataset("count", 24)
+    events = []
+    train(_cfg(tmp_path, data, epochs=1, batch_size=8, checkpoint_minutes=1e-9),
+          lambda kind, **f: events.append((kind, f)))
+    mid = [f["batch"] for k, f in events if k == "checkpoint" and f["epoch"] == 0]
+    assert mid == [1, 2, 3]  # after every step (21 training windows -> 3 batches of 8, 8, 5)
+    assert ("checkpoint", {"path": tmp_path / "m.ckpt.pt", "epoch": 1, "batch": 0}) in events  # epoch end

@@ -109,7 +109,12 @@ def main(argv: list[str] | None = None) -> None:
     warnings.showwarning = _show
     command = typer.main.get_command(app)
     try:
-        command.main(args=argv, prog_name="wallcli", standalone_mode=False)
+        rv = command.main(args=argv, prog_name="wallcli", standalone_mode=False)
+        # Without standalone mode, click *returns* the code of an Exit it caught (Ctrl-C -> 130).
+        if isinstance(rv, int) and rv:
+            if rv == 130:
+                _fail("interrupted", 130)
+            sys.exit(rv)
     except WallcliError as exc:
         if _debug():
             raise

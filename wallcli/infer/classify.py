@@ -82,7 +82,9 @@ def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64,
         from wallcli.signal.stplot import FORMAT, from_arrays
 
         if roi is not None:
-            raise WallcliError("--roi applies to videos; a space-time plot already has its region")
+            from wallcli.errors import UsageError
+
+            raise UsageError("--roi applies to videos; a space-time plot already has its region")
         return from_arrays(*load_npz(source, kind=FORMAT), source=str(source))
     from wallcli.io.video import open_video
     from wallcli.signal.stplot import compute_stplot

@@ -19,18 +19,16 @@ SHIPPED = {"count": "count.onnx", "activity": "activity.onnx"}
 
 
 def shipped_model_path(task: str) -> Path:
-    """The model shipped inside the wheel (package data ``wallcli/models/``).
-
-    In a source checkout the models live in the repository's top-level ``models/``;
-    packaging maps that folder to ``wallcli/models`` in the wheel.
-    """
+    """The model shipped with wallcli: package data ``wallcli.models`` (the repository's
+    top-level ``models/`` folder, mapped to that package by pyproject.toml)."""
     name = SHIPPED[task]
     try:
-        res = resources.files("wallcli") / "models" / name
+        res = resources.files("wallcli.models") / name
         if res.is_file():
             return Path(str(res))
-    except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
+    except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError, TypeError):
         pass
+    # a source checkout run without installing (PYTHONPATH=.): the folder itself
     return Path(__file__).resolve().parents[2] / "models" / name
 
 
@@ -117,9 +115,13 @@ class Model:
                     isinstance(s, int) and w is not None and s != w for s, w in zip(shape, want)):
                 raise WallcliError(f"model {self.path} input {spec['name']!r} has shape {shape}, card says {want}",
                                    hint="wrong card for this model")
-        outs = sess.get_outputs()
-        if outs[0].name != OUTPUT_NAME:
-            raise WallcliError(f"model {self.path} output is {outs[0].name!r}, expected {OUTPUT_NAME!r}")
+        out = sess.get_outputs()[0]
+        if out.name != OUTPUT_NAME:
+            raise WallcliError(f"model {self.path} output is {out.name!r}, expected {OUTPUT_NAME!r}")
+        k = out.shape[-1] if out.shape else None
+        if isinstance(k, int) and k != len(self.classes):
+            raise WallcliError(f"model {self.path} outputs {k} classes, its card lists {len(self.classes)}",
+                               hint="wrong card for this model")
 
     def predict(self, inputs: dict[str, np.ndarray], batch: int = 32) -> np.ndarray:
         """Class probabilities (N, classes), float64, for normalised windows (N, 3, bins, window)."""

@@ -24,7 +24,7 @@ SHARD_FORMAT = "wallcli.dataset-shard"
 
 class ShardDataset:
     def __init__(self, root: Path | str, task: str, *, bins: int = 64, window: int = 256,
-                 buffer_windows: int = 4096) -> None:
+                 buffer_windows: int = 2048) -> None:
         self.root = Path(root)
         man_path = self.root / "dataset.json"
         if not man_path.is_file():
@@ -36,6 +36,9 @@ class ShardDataset:
             raise WallcliError(f"{man_path} is not valid JSON: {e}") from None
         if man.get("format") != DATASET_FORMAT or man.get("version") != 1:
             raise WallcliError(f"{man_path}: not a {DATASET_FORMAT} v1 manifest")
+        if man.get("complete") is False:
+            raise WallcliError(f"{self.root} is still being written (dataset.json says complete: false)",
+                               hint="finish it by re-running the same dataset command")
         if man.get("task") != task:
             raise WallcliError(f"{self.root} is a {man.get('task')!r} dataset, training a {task!r} model needs a {task!r} one")
         if list(man.get("classes", [])) != TASK_CLASSES[task]:
@@ -88,10 +91,6 @@ class ShardDataset:
             _, old = self._cache.popitem(last=False)
             self._cache_windows -= len(old["label"])
         return out
-
-    def labels(self) -> np.ndarray:
-        """All labels (loads every shard once; used for class counts and stratification)."""
-        return np.concatenate([self._load_shard(i)["label"] for i in range(len(self.files))])
 
     def gather(self, idx: np.ndarray) -> dict[str, np.ndarray]:
         """Raw windows (len(idx), bins, window, 3) per input, plus 'label', in the order of idx."""

@@ -20,11 +20,11 @@ import torch
 from wallcli.errors import WallcliError
 from wallcli.infer.card import (CARD_FORMAT, CARD_VERSION, OUTPUT_NAME, PREPROCESSING, card_path,
                                 input_spec, sha256_file, write_card)
-from wallcli.train.nets import BINS, WINDOW, WithSoftmax
+from wallcli.signal.window import BINS, CANONICAL_FPS, DEFAULT_STRIDE, WINDOW
+from wallcli.train.nets import WithSoftmax
 
 OPSET = 17
 PARITY_TOL = 1e-4
-DEFAULT_STRIDE = 64
 
 
 def export_onnx(net: torch.nn.Module, input_names: list[str], path: Path) -> None:
@@ -65,8 +65,6 @@ def build_card(*, name: str, version: str, task: str, classes: list[Any], input_
                sha256: str, size_bytes: int, parameters: int, stride: int = DEFAULT_STRIDE,
                training_data: dict[str, Any], training: dict[str, Any], validation: dict[str, Any] | None,
                onnx_file: str, parity: float) -> dict[str, Any]:
-    from wallcli.signal.window import CANONICAL_FPS
-
     return {
         "format": CARD_FORMAT, "card_version": CARD_VERSION,
         "name": name, "version": version, "task": task, "classes": list(classes),
@@ -75,7 +73,7 @@ def build_card(*, name: str, version: str, task: str, classes: list[Any], input_
         "preprocessing": PREPROCESSING,
         "normalisation": "per (bin, colour) temporal mean over the window removed, then divided by the "
                          "window's global RMS; channels first (N, 3, bins, time)",
-        "fps": CANONICAL_FPS, "window": WINDOW, "bins": BINS, "stride": stride,
+        "fps": int(CANONICAL_FPS) if float(CANONICAL_FPS).is_integer() else CANONICAL_FPS, "window": WINDOW, "bins": BINS, "stride": stride,
         "clip_aggregation": "mean of window probabilities",
         "onnx": {"file": onnx_file, "opset": OPSET, "bytes": size_bytes, "parameters": parameters,
                  "parity_max_abs_diff": parity, "torch": torch.__version__},

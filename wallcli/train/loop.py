@@ -14,7 +14,7 @@ from __future__ import annotations
 import copy
 import os
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Callable
 
@@ -49,8 +49,7 @@ class TrainConfig:
     resume: bool = True
     augment: bool = True
     channels_last: bool = True  # measured faster on CPU (bench/bench_train.py)
-    buffer_windows: int = 4096
-    extra: dict[str, Any] = field(default_factory=dict)
+    buffer_windows: int = 2048
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
@@ -128,7 +127,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
     best: dict[str, Any] = {"accuracy": -1.0, "epoch": None, "state": None, "validation": None}
     if cfg.resume and ckpt_path.is_file():
         try:
-            ck = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+            ck = torch.load(ckpt_path, map_location="cpu", weights_only=True)  # data only, never code
         except Exception as e:  # a truncated or foreign file
             raise WallcliError(f"cannot read checkpoint {ckpt_path}: {e}", hint="delete it or pass --no-resume") from None
         if ck.get("format") != CKPT_FORMAT or ck.get("identity") != ident:
@@ -143,7 +142,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         _save_checkpoint(ckpt_path, {
             "format": CKPT_FORMAT, "version": 1, "identity": ident, "config": {k: str(v) for k, v in asdict(cfg).items()},
             "model": net.state_dict(), "optimizer": opt.state_dict(), "epoch": ep, "batch": batch,
-            "history": history, "best": best, "torch": torch.__version__})
+            "history": history, "best": best, "torch": str(torch.__version__)})
         emit("checkpoint", path=ckpt_path, epoch=ep, batch=batch)
 
     last_ckpt = time.monotonic()
@@ -154,7 +153,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         seen = correct = 0
         loss_sum = 0.0
         t0 = time.monotonic()
-        bi = start_batch
+        next_batch = start_batch
         try:
             for bi in range(start_batch, len(batches)):
                 b = ds.gather(batches[bi])
@@ -169,16 +168,18 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
                     raise WallcliError(f"training diverged (loss {float(loss)}) at epoch {epoch + 1} batch {bi + 1}")
                 loss.backward()
                 opt.step()
+                next_batch = bi + 1
                 n = len(y)
                 seen += n
-                loss_sum += float(loss) * n
+                loss_sum += float(loss.detach()) * n
                 correct += int((logits.argmax(1) == y).sum())
                 emit("step", epoch=epoch, batch=bi + 1, batches=len(batches), loss=loss_sum / seen, accuracy=correct / seen)
                 if time.monotonic() - last_ckpt > cfg.checkpoint_minutes * 60:
                     checkpoint(epoch, bi + 1)
                     last_ckpt = time.monotonic()
         except KeyboardInterrupt:
-            checkpoint(epoch, bi)  # the interrupted batch did not finish: redo it on resume
+            # resume after the last completed step; the epoch's running loss/accuracy restart
+            checkpoint(epoch, next_batch)
             raise
         val = evaluate(net, val_ds, val_idx, max(cfg.batch_size, 64), cfg.channels_last) if len(val_idx) else None
         rec = {"epoch": epoch + 1, "train_loss": loss_sum / seen if seen else None,

@@ -1,0 +1,90 @@
+import json
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+onnx = pytest.importorskip("onnx")
+
+from wallcli.cli.app import main  # noqa: E402
+from wallcli.infer.card import read_card, sha256_file  # noqa: E402
+from wallcli.infer.model import Model  # noqa: E402
+from wallcli.train.export import check_parity, export_model  # noqa: E402
+from wallcli.train.nets import build  # noqa: E402
+
+def run_cli(args):
+    try:
+        main(args)
+    except SystemExit as e:
+        return e.code or 0
+    return 0
+
+
+FIELDS = dict(name="t", version="0.0.1", training_data={"recipe": {}}, training={"seed": 0}, validation=None)
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
+def test_export_parity_dynamic_batch_and_card(tmp_path, task):
+    torch.manual_seed(0)
+    net = build(task).eval()
+    inputs = list(net.input_names)
+    out = tmp_path / f"{task}.onnx"
+    card = export_model(net, inputs, out, dict(FIELDS, task=task, classes=net.classes))
+    assert card["onnx"]["parity_max_abs_diff"] <= 1e-4
+    assert card["sha256"] == sha256_file(out)
+    assert read_card(out) == json.loads(json.dumps(card))  # what was written is what was returned
+    m = onnx.load(str(out))
+    assert max(o.version for o in m.opset_import if o.domain in ("", "ai.onnx")) >= 17
+    assert [i.name for i in m.graph.input] == inputs
+    assert m.graph.input[0].type.tensor_type.shape.dim[0].dim_param  # symbolic batch
+    # onnxruntime agrees with torch for batches the export never saw
+    model = Model.load(out, task=task)
+    for n in (1, 7):
+        xs = [np.random.default_rng(n).normal(size=(n, 3, 64, 256)).astype(np.float32) for _ in inputs]
+        ref = torch.softmax(net(*map(torch.from_numpy, xs)), 1).detach().numpy()
+        got = model.predict(dict(zip(inputs, xs)))
+        assert np.abs(got - ref).max() <= 1e-4
+    assert card["preprocessing"] == "wallcli.signal.window.normalize_window v1"
+    assert (card["fps"], card["window"], card["bins"], card["stride"]) == (30, 256, 64, 64)
+    assert card["inputs"][0]["layout"] == "NCHW" and card["inputs"][0]["shape"] == [None, 3, 64, 256]
+
+
+def test_parity_check_detects_a_different_model(tmp_path):
+    torch.manual_seed(0)
+    net = build("count").eval()
+    out = tmp_path / "c.onnx"
+    export_model(net, ["horizontal"], out, dict(FIELDS, task="count", classes=[0, 1, 2]))
+    torch.manual_seed(1)
+    with pytest.raises(Exception, match="differs"):
+        check_parity(build("count").eval(), ["horizontal"], out)
+
+
+def test_train_command_end_to_end(make_dataset, tmp_path, capsys):
+    data = make_dataset("count", 20)
+    val = make_dataset("count", 6, seed=9, shards=1, name="val")
+    out = tmp_path / "models" / "count.onnx"
+    out.parent.mkdir()
+    args = ["train", "count", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
+            "--batch-size", "8", "--threads", "2", "--model-version", "0.1.0"]
+    assert run_cli(args) == 0
+    card = read_card(out)
+    assert card["task"] == "count" and card["classes"] == [0, 1, 2] and card["version"] == "0.1.0"
+    assert card["sha256"] == sha256_file(out)
+    assert card["training_data"]["recipe"] == {"generator": "tests/train/conftest.py streaks"}
+    assert card["training_data"]["windows"] == 20 and card["training"]["optimizer"] == "RMSprop"
+    assert card["training"]["lr"] == 1e-3 and card["training"]["augmentation"]
+    v = card["validation"]
+    assert v["windows"] == 6 and np.array(v["confusion_matrix"]).shape == (3, 3)
+    assert np.array(v["confusion_matrix"]).sum() == 6 and 0.0 <= v["accuracy"] <= 1.0
+    assert out.with_suffix(".ckpt.pt").is_file()
+    assert capsys.readouterr().out == ""  # nothing but data on stdout
+    # an existing model is never overwritten without --force, and the check comes before training
+    assert run_cli(args) == 1
+    assert "exists" in capsys.readouterr().err
+
+
+def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path):
+    monkeypatch.setitem(__import__("sys").modules, "torch", None)  # import torch -> ImportError
+    assert run_cli(["train", "count", "--data", str(tmp_path), "--out", str(tmp_path / "m.onnx")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("Error:") and "pip install torch==2.13.0 && pip install 'wallcli[train]'" in err

@@ -1,0 +1,73 @@
+"""The one implementation behind ``wallcli count`` and ``wallcli activity``.
+
+Both commands differ only in the task name (which selects the shipped model and the
+classes), so each is a thin typer function calling :func:`run`.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from wallcli.cli.common import ROI_HELP, input_argument, parse_roi
+
+INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
+STRIDE_OPT = typer.Option(None, "--stride", min=1, help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
+JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see CONTRACT.md).")
+PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG.")
+MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
+THREADS_OPT = typer.Option(0, "--threads", min=0, help="onnxruntime intra-op threads (0: onnxruntime chooses).")
+FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
+ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
+FORCE_OPT = typer.Option(False, "--force", help="Overwrite the --plot file.")
+INPUT_ARG = input_argument(INPUT_HELP)
+
+
+def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
+        model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool) -> None:
+    from wallcli.errors import UsageError
+
+    roi_t = parse_roi(roi)
+    if follow and plot is not None:
+        raise UsageError("--plot needs the whole clip; it cannot be combined with --follow")
+    if follow and str(input).lower().endswith(".npz"):
+        raise UsageError("--follow reads live video; a .npz space-time plot is already complete")
+
+    from wallcli.cli.output import emit_json, print_table, progress
+    from wallcli.infer.model import load_model
+    from wallcli.io.writer import check_output
+
+    if plot is not None:
+        check_output(plot, force=force, inputs=[input])
+    model = load_model(task, model_path, threads=threads)
+    stride = int(stride or model.card["stride"])
+
+    if follow:
+        from wallcli.infer.classify import follow as follow_windows
+
+        for rec in follow_windows(model, input, stride=stride, roi=roi_t):
+            emit_json(rec)
+        return
+
+    from wallcli.infer.classify import classify_plot, load_plot
+
+    with progress(task, None, enabled=not str(input).lower().endswith(".npz")) as advance:
+        st = load_plot(input, roi=roi_t, bins=model.bins, progress=advance)
+    result = classify_plot(model, st, stride=stride, source=str(input))
+    if plot is not None:
+        from wallcli.plots.timeline import save_timeline_png
+
+        save_timeline_png(plot, result, st, force=force)
+    if json_out:
+        emit_json(result)
+        return
+    # one row per window (each lasts window/fps seconds from its start) and the clip's answer;
+    # no 'end' column so that five classes fit an 80-column terminal
+    classes = result["classes"]
+    rows = [[f"{w['start']:.2f}", w["label"], *(f"{p:.3f}" for p in w["probabilities"])] for w in result["windows"]]
+    rows.append(["clip", result["label"], *(f"{p:.3f}" for p in result["probabilities"])])
+    span = result["window"] / result["fps"]
+    print_table(f"{input}: {task} = {result['label']} (p={max(result['probabilities']):.2f}; "
+                f"{len(result['windows'])} windows of {span:.2f} s)",
+                ["start (s)", "label", *(f"{c} people" if isinstance(c, int) else str(c) for c in classes)], rows)

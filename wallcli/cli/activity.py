@@ -1,0 +1,36 @@
+"""``wallcli activity INPUT``: what one person in the hidden part of the room is doing."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+from wallcli.cli._classify import (FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
+                                   STRIDE_OPT, THREADS_OPT, run)
+
+
+def activity(
+    input: str = INPUT_ARG,
+    stride: Optional[int] = STRIDE_OPT,
+    json_out: bool = JSON_OPT,
+    plot: Optional[Path] = PLOT_OPT,
+    model: Optional[Path] = MODEL_OPT,
+    threads: int = THREADS_OPT,
+    follow: bool = FOLLOW_OPT,
+    roi: Optional[str] = ROI_OPT,
+    force: bool = FORCE_OPT,
+) -> None:
+    """Recognise what a person out of view is doing: none, walking, crouching, waving or jumping.
+
+    Both space-time plots (horizontal and vertical) are cut into 256-frame windows (8.5 s at 30 fps, any
+    input frame rate is resampled); the seed's two-branch CNN classifies each; the clip's answer is
+    the mean of the window probabilities.
+
+    \b
+    Examples:
+      wallcli activity clip.mp4
+      wallcli activity plots.npz --json
+      wallcli activity clip.mp4 --plot timeline.png --stride 32
+      ffmpeg -i rtsp://cam/stream -f nut - | wallcli activity - --follow
+    """
+    run("activity", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
+        follow=follow, roi=roi, force=force)
