@@ -32,6 +32,10 @@ def train(
     name: Optional[str] = typer.Option(None, "--name", help="Model name in the card (default: wallcli-TASK)."),
     model_version: str = typer.Option("1.0.0", "--model-version", help="Model version in the card."),
     stride: int = typer.Option(64, "--stride", min=1, help="Default inference stride recorded in the card (frames)."),
+    min_snr_db: Optional[float] = typer.Option(None, "--min-snr-db", help="Skip training windows whose movers' "
+                                               "noise-free signal is this many dB below the plot noise or more (per-window "
+                                               "snr_db from the simulator); windows with nobody moving always stay. "
+                                               "Validation keeps every window."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
@@ -70,7 +74,8 @@ def train(
     check_output(card_path(out), force=force)
     cfg = TrainConfig(task=task.value, data=data, out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
-                      checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment)
+                      checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
+                      min_snr_db=min_snr_db)
 
     _sigterm_interrupts()
     with _TrainProgress(console_err) as bar:
@@ -92,14 +97,15 @@ def train(
     fields = dict(
         name=name or f"wallcli-{task.value}", version=model_version, task=task.value, classes=ds.classes, stride=stride,
         training_data={"dataset": str(data), "recipe": ds.manifest.get("recipe"), "seed": ds.manifest.get("seed"),
-                       "windows": ds.n, "train_windows": result["train_windows"]},
+                       "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
         training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
                   "loss": "cross-entropy", "augmentation": DESCRIPTION if augment else [],
                   "selected_epoch": result["best_epoch"], "history": result["history"],
                   "command": f"wallcli train {task.value} --data {data} --out {out} --epochs {epochs} "
                              f"--batch-size {batch_size} --seed {seed}"
                              + (f" --val {val}" if val else f" --val-fraction {val_fraction}")
-                             + ("" if augment else " --no-augment")},
+                             + ("" if augment else " --no-augment")
+                             + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")},
         validation=validation,
     )
     card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed)

@@ -48,6 +48,33 @@ def _window_starts(length: int, k: int, rng) -> list[int]:
     return sorted(int(v) for v in np.clip(np.rint(base + jitter), 0, span))
 
 
+def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) -> np.ndarray:
+    """Per window: power of the people's noise-free signal over the plot's noise power, in dB.
+
+    Signal: the renderer's noise-free relative irradiance change averaged over wall rows, times
+    the wall level (and the tone curve's slope 1/gamma), resampled like the plot. Noise: the
+    seed's estimator (half the power of frame-to-frame differences) on the final window. NaN
+    where nobody moves (or in flatland). Lets training report accuracy against visibility.
+    """
+    from wallcli.signal.window import resample
+
+    out = np.full(len(starts), np.nan, np.float32)
+    profiles = getattr(scene, "clean_profiles", None)
+    if not profiles:
+        return out
+    clean = np.stack([p[0] for p in profiles], axis=1) * (cam.level / (cam.gamma or 1.0))  # (gx, T, 3)
+    clean, _ = resample(clean, np.arange(clean.shape[1]) / cam.fps, FPS)
+    for k, s in enumerate(starts):
+        sig_w = clean[:, s : s + WINDOW]
+        if sig_w.shape[1] < WINDOW:
+            continue
+        sig = float(np.mean(np.var(sig_w, axis=1)))
+        noise = 0.5 * float(np.mean(np.square(np.diff(h[:, s : s + WINDOW], axis=1))))
+        if sig > 0 and noise > 0:
+            out[k] = 10.0 * np.log10(sig / noise)
+    return out
+
+
 def render_windows(seed: int, index: int, task: str, *, domain: str = "base", world: str = "room",
                    windows: int = 3, grid: tuple[int, int] = (24, 32), tmpdir: str | None = None,
                    camera_overrides: dict | None = None) -> dict:
@@ -73,6 +100,7 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         cfg = SceneConfig(people=people, activities=acts or None, duration=duration, grid=grid, domain=domain,
                           camera_overrides=dict(camera_overrides or {}))
         scene = sample_scene(seed, cfg, index=index)
+        scene.clean_profiles = []
     cam = scene.camera
     suffix = ".mkv" if cam.codec == "ffv1" else ".mp4"
     fd, name = tempfile.mkstemp(suffix=suffix, dir=tmpdir)
@@ -90,6 +118,7 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
     h, t = resample(plot.horizontal, plot.time, FPS)
     v, _ = resample(plot.vertical, plot.time, FPS)
     starts = _window_starts(h.shape[1], windows, rng)
+    snr = _window_snr_db(scene, cam, h, t, starts)
     truth = scene.truth()
     meta = {k: truth[k] for k in ("people", "activity", "activities", "fps", "frames", "width", "height", "domain")}
     meta.update(seed=int(seed), index=int(index), world=world, camera=truth["camera"],
@@ -101,5 +130,6 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         "label": np.full(len(starts), label, np.int64),
         "people": np.full(len(starts), len(acts), np.int64),
         "activity": np.full(len(starts), activity, np.int64),
+        "snr_db": snr,
         "scenes": [dict(meta, window_start_s=round(s / FPS, 3)) for s in starts],
     }

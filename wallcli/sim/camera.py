@@ -58,9 +58,12 @@ def sample_camera(rng: np.random.Generator, domain: str = "base", *, nuisance_p:
     p = CameraParams(width=w, height=max(h, 64))
     p.fps = float(rng.choice([15, 24, 25, 30, 30, 30, 48, 60]) if not shifted else rng.choice([20, 29.97, 50]))
     p.level = rng.uniform(50, 200)
-    p.gain = float(np.exp(rng.uniform(np.log(0.01), np.log(3.0 if not shifted else 5.0))))
+    # Photon transfer of real cameras at indoor levels: 0.01-1 codes per electron (shot noise
+    # 1-11 codes rms per pixel at level 120); the wall covers 50k-2M sensor pixels. The shifted
+    # domain moves both ranges (noisier, smaller walls) without leaving the physical regime.
+    p.gain = float(np.exp(rng.uniform(np.log(0.01), np.log(1.0)) if not shifted else rng.uniform(np.log(0.02), np.log(1.5))))
     p.read_noise = rng.uniform(0.3, 3.0)
-    p.sensor_pixels = float(np.exp(rng.uniform(np.log(3e4), np.log(2e6))))
+    p.sensor_pixels = float(np.exp(rng.uniform(np.log(5e4), np.log(2e6)) if not shifted else rng.uniform(np.log(4e4), np.log(1.5e6))))
     p.prnu = rng.uniform(0.002, 0.02)
     p.texture = rng.uniform(0.005, 0.05)
     p.vignette = rng.uniform(0.0, 0.4)

@@ -54,6 +54,10 @@ class Scene:
     poses: list[dict]
     times: np.ndarray
     rng: np.random.Generator
+    # Set to [] before frames() to collect, per frame, the noise-free relative irradiance change
+    # averaged over wall rows and columns: ((gx, 3), (gy, 3)). Dataset mode uses it to measure
+    # how visible the people are in each window.
+    clean_profiles: list | None = None
 
     @property
     def label_activity(self) -> str:
@@ -97,6 +101,9 @@ class Scene:
                 dE = body_delta(self.room, self.points, C, R, body_radiance(self.room, C, A, view), bbox, pairs)
             else:
                 dE = np.zeros_like(E0)
+            if self.clean_profiles is not None:
+                rel = dE / np.maximum(E0, 1e-12)
+                self.clean_profiles.append((rel.mean(axis=0), rel.mean(axis=1)))
             yield cam.render(dE, i, static_E=E0)
 
     def truth(self, frames: int | None = None) -> dict:

@@ -105,6 +105,29 @@ class ShardDataset:
                 out[name][sel] = arrs[name][local]
         return out
 
+    def visible(self, indices: np.ndarray, min_snr_db: float | None) -> np.ndarray:
+        """``indices`` without windows whose movers are too faint to see (snr_db < min_snr_db).
+
+        Windows with nobody moving (snr_db NaN) always stay. A label the data cannot support
+        (a waving person 5 m away, 40 dB under the noise) teaches only guessing.
+        """
+        indices = np.asarray(indices, dtype=np.int64)
+        if min_snr_db is None:
+            return indices
+        import zipfile
+
+        snr = np.full(self.n, np.nan, np.float32)
+        for i, f in enumerate(self.files):
+            try:
+                with np.load(f, allow_pickle=False) as npz:
+                    if "snr_db" not in npz.files:
+                        raise WallcliError(f"{f} has no per-window snr_db; regenerate it to filter by visibility")
+                    snr[self.offsets[i]:self.offsets[i + 1]] = npz["snr_db"]
+            except (OSError, ValueError, zipfile.BadZipFile) as e:
+                raise WallcliError(f"{f} is not a readable shard ({e})") from None
+        s = snr[indices]
+        return indices[np.isnan(s) | (s >= min_snr_db)]
+
     # -- epochs -----------------------------------------------------------------------
     def plan(self, indices: np.ndarray, batch_size: int, rng: np.random.Generator,
              shuffle: bool = True) -> list[np.ndarray]:

@@ -50,6 +50,7 @@ class TrainConfig:
     augment: bool = True
     channels_last: bool = True  # measured faster on CPU (bench/bench_train.py)
     buffer_windows: int = 2048
+    min_snr_db: float | None = None  # drop training windows whose movers are fainter than this
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
@@ -97,7 +98,7 @@ def _save_checkpoint(path: Path, state: dict[str, Any]) -> None:
 def _identity(cfg: TrainConfig, ds: ShardDataset) -> dict[str, Any]:
     # what must match for a checkpoint to be resumable into this run
     return {"task": cfg.task, "windows": ds.n, "dataset_seed": ds.manifest.get("seed"),
-            "seed": cfg.seed, "batch_size": cfg.batch_size, "val_fraction": cfg.val_fraction if cfg.val is None else None}
+            "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None}
 
 
 def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
@@ -113,6 +114,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
     else:
         val_ds = ds
         train_idx, val_idx = split_validation(ds.n, cfg.val_fraction, cfg.seed)
+    train_idx = ds.visible(train_idx, cfg.min_snr_db)
     if len(train_idx) < 2:
         raise WallcliError(f"{cfg.data} has too few windows to train on ({ds.n})")
 
