@@ -100,6 +100,19 @@ def test_corrupt_npz(tmp_path):
         load_npz(bad)
 
 
+def test_non_zip_npz_is_refused_without_unpickling_advice(tmp_path):
+    import pickle
+
+    from wallcli.errors import WallcliError
+    from wallcli.io.arrays import load_npz
+
+    evil = tmp_path / "p.npz"
+    evil.write_bytes(pickle.dumps({"format": "wallcli.stplot"}))
+    with pytest.raises(WallcliError, match="not a readable .npz") as info:
+        load_npz(evil)
+    assert "pickle" not in str(info.value)
+
+
 def test_pickled_npz_is_refused(tmp_path):
     from wallcli.errors import WallcliError
     from wallcli.io.arrays import load_npz
@@ -116,3 +129,25 @@ def test_debug_env_shows_traceback(tmp_path, run_cli, monkeypatch):
     monkeypatch.setenv("WALLCLI_DEBUG", "1")
     with pytest.raises(WallcliError):
         run_cli("stplot", tmp_path / "nope.mp4", "--json")
+
+
+def test_sigterm_removes_the_temporary_output(tmp_path):
+    # `kill PID` must unwind like Ctrl-C: one error line, and no `.NAME.XXXX.tmp.mp4` left behind.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "v.mp4"
+    proc = subprocess.Popen([sys.executable, "-m", "wallcli", "simulate", "-o", str(out), "--size", "64x48",
+                             "--duration", "600", "--grid", "8x8"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not list(tmp_path.glob(".v.*.tmp.mp4")) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    assert list(tmp_path.glob(".v.*.tmp.mp4")), "the temporary output never appeared"
+    proc.send_signal(signal.SIGTERM)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 1 and stdout == ""
+    assert stderr.strip().splitlines() == ["Error: interrupted"]
+    assert list(tmp_path.iterdir()) == []

@@ -232,3 +232,29 @@ def test_bad_input(run_cli, tmp_path, gaussian_clip):
     short = _lossless(tmp_path / "short.mkv", lambda i: np.full((16, 16, 3), 100.0 + i), n=2)
     code, out, err = run_cli("snr", short, "--json")
     assert code == 1 and "at least 3" in err and out == ""
+
+
+def test_lattice_tiles_stay_on_whole_chroma_samples():
+    # ROI height 130 (2 mod 4) centred a 128-row lattice at row 1: an odd luma row paired with
+    # the wrong 4:2:0 chroma row. Every sampled pixel must get the chroma sample that covers it.
+    from wallcli.io.video import Planes
+    from wallcli.signal.snr import Lattice
+
+    lat = Lattice.plan((0, 0, 256, 130), 32768)
+    assert not lat.exact and lat.oy % 2 == 0 and lat.ox % 2 == 0
+    rng = np.random.default_rng(0)
+    y = rng.integers(16, 235, (130, 256), dtype=np.uint8)
+    u = rng.integers(16, 240, (65, 128), dtype=np.uint8)
+    v = rng.integers(16, 240, (65, 128), dtype=np.uint8)
+    planes = Planes(y, u, v, kind="yuv", sub_x=1, sub_y=1)
+    acc = SnrAccumulator((0, 0, 256, 130))
+    acc.update(planes)
+    got = acc._rgb(planes)  # (3, nty, th, ntx, tw)
+    rows = lat.oy + np.arange(lat.nty)[:, None] * lat.step_y + np.arange(lat.th)[None, :]
+    cols = lat.ox + np.arange(lat.ntx)[:, None] * lat.step_x + np.arange(lat.tw)[None, :]
+    r, c = rows.reshape(-1)[:, None], cols.reshape(-1)[None, :]
+    want = planes.to_rgb(y[r, c].astype(float), u[r // 2, c // 2].astype(float), v[r // 2, c // 2].astype(float))
+    want = want.reshape(lat.nty, lat.th, lat.ntx, lat.tw, 3).transpose(4, 0, 1, 2, 3)
+    off = planes.to_rgb(np.zeros(1), np.zeros(1), np.zeros(1))[0]  # _rgb drops the affine offset
+    assert np.abs(got + off[:, None, None, None, None] - want).max() < 0.05  # float32 rounding only
+

@@ -1,6 +1,7 @@
 """`wallcli stplot`: the .npz format, the PNG, the mean modes."""
 
 import json
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -69,3 +70,22 @@ def test_stplot_requires_an_action(tmp_path, run_cli):
     clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 5)
     code, _, err = run_cli("stplot", clip)
     assert code == 2 and err.startswith("Error:")
+
+
+def test_decoded_frame_size_wins_over_the_announced_one():
+    # Some streams announce no size (0x0) or a wrong one: the default ROI is the decoded frame.
+    from types import SimpleNamespace
+
+    from wallcli.io.video import Planes
+    from wallcli.signal.stplot import compute_stplot
+
+    def frames():
+        for i in range(3):
+            img = np.full((24, 32), 100 + i, np.uint8)
+            img[:, 16:] += 10
+            yield SimpleNamespace(index=i, time=i / 30, planes=Planes(img, img, img, kind="rgb"))
+
+    reader = SimpleNamespace(info=SimpleNamespace(source="s", width=0, height=0, fps=Fraction(30)), frames=frames)
+    plot = compute_stplot(reader, bins=4)
+    assert plot.meta["roi"] == [0, 0, 32, 24] and plot.meta["frame_size"] == [32, 24]
+    assert np.allclose(plot.h_mean[:, 0], [101, 101, 111, 111])

@@ -138,3 +138,16 @@ def test_reader_is_single_pass(tmp_path):
         list(reader.frames())
         with pytest.raises(RuntimeError):
             list(reader.frames())
+
+
+def test_close_stops_the_decoder_before_the_container(tmp_path):
+    # A consumer that raises inside its loop leaves frames() suspended; close() (the with-block's
+    # exit) must still stop and join the decoder thread before FFmpeg's container is freed.
+    path = write_clip(tmp_path / "c.mp4", _gradient(32, 32), 40)
+    with pytest.raises(KeyError):
+        with open_video(path) as reader:
+            frames = reader.frames()
+            for _ in frames:
+                raise KeyError("consumer failed")
+    assert reader._worker is None
+    assert not any(t.name == "wallcli-decode" and t.is_alive() for t in __import__("threading").enumerate())

@@ -96,6 +96,19 @@ def _click_exceptions():
     return Abort, ClickException, Exit, UsageError
 
 
+def _sigterm_interrupts() -> None:
+    # `kill PID` (SIGTERM) must unwind like Ctrl-C, so atomic_path removes its temporary file;
+    # the default action would end the process on the spot and leave `.NAME.XXXX.tmp.EXT` behind.
+    import signal
+    import threading
+
+    def handler(signum, frame):
+        raise KeyboardInterrupt
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, handler)
+
+
 def main(argv: list[str] | None = None) -> None:
     from wallcli.errors import WallcliError
 
@@ -107,13 +120,15 @@ def main(argv: list[str] | None = None) -> None:
         sys.stderr.write(f"Warning: {message}\n")
 
     warnings.showwarning = _show
+    _sigterm_interrupts()
     command = typer.main.get_command(app)
     try:
         rv = command.main(args=argv, prog_name="wallcli", standalone_mode=False)
-        # Without standalone mode, click *returns* the code of an Exit it caught (Ctrl-C -> 130).
+        # Without standalone mode, click *returns* the code of an Exit it caught (Ctrl-C -> 130);
+        # the contract knows 0, 1 and 2 only: an interrupted job is work that failed (1).
         if isinstance(rv, int) and rv:
             if rv == 130:
-                _fail("interrupted", 130)
+                _fail("interrupted", 1)
             sys.exit(rv)
     except WallcliError as exc:
         if _debug():
@@ -122,7 +137,7 @@ def main(argv: list[str] | None = None) -> None:
     except Exit as exc:
         sys.exit(exc.exit_code)
     except Abort:
-        _fail("interrupted", 130)
+        _fail("interrupted", 1)
     except ClickUsageError as exc:
         if _debug():
             raise
@@ -138,7 +153,7 @@ def main(argv: list[str] | None = None) -> None:
     except KeyboardInterrupt:
         if _debug():
             raise
-        _fail("interrupted", 130)
+        _fail("interrupted", 1)
     except BrokenPipeError:
         # `wallcli ... | head`: the reader left; not our failure.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -114,7 +114,7 @@ def train(
 
 
 def _sigterm_interrupts() -> None:
-    """`kill PID` of a background run saves a checkpoint like Ctrl-C does (then exits 130)."""
+    """`kill PID` of a background run saves a checkpoint like Ctrl-C does (then exits 1)."""
     import signal
     import threading
 

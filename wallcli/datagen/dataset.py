@@ -61,9 +61,19 @@ def _work(args):
     return index, out
 
 
+def _terminated(signum, frame):
+    raise SystemExit(0)
+
+
 def _init_worker():
     # one BLAS thread per worker: the cores are already shared out by processes
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+    # Pool.terminate() sends SIGTERM: exit quietly (not the CLI's KeyboardInterrupt handler,
+    # inherited through fork, which would print a traceback per worker) and through the
+    # `finally` blocks, so render_windows removes its temporary video.
+    import signal
+
+    signal.signal(signal.SIGTERM, _terminated)
     np.seterr(all="ignore")
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -32,10 +33,14 @@ def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[
     p = Path(path)
     if not p.is_file():
         raise WallcliError(f"no such file: {p}")
+    # np.load falls back to unpickling for anything that is not a zip or .npy, and its refusal
+    # then advises allow_pickle=True: never the advice for a file a user fed us by mistake.
+    if not zipfile.is_zipfile(p):
+        raise WallcliError(f"{p} is not a readable .npz file (not a zip archive)")
     try:
         with np.load(p, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as exc:
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, zlib.error) as exc:
         raise WallcliError(f"{p} is not a readable .npz file ({type(exc).__name__}: {exc})") from exc
     meta_arr = arrays.pop(META_KEY, None)
     if meta_arr is None:

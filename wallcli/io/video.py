@@ -238,6 +238,7 @@ class VideoReader:
             duration=duration,
         )
         self._used = False
+        self._worker = None  # (thread, queue, stop event) while frames() runs
 
     # -- decoding -------------------------------------------------------------------------------
     def _decode_into(self, q: "queue.Queue", stop: threading.Event) -> None:
@@ -275,6 +276,7 @@ class VideoReader:
         q: queue.Queue = queue.Queue(maxsize=_QUEUE_SIZE)
         stop = threading.Event()
         worker = threading.Thread(target=self._decode_into, args=(q, stop), daemon=True, name="wallcli-decode")
+        self._worker = (worker, q, stop)
         worker.start()
         index = 0
         first_pts = None
@@ -309,12 +311,7 @@ class VideoReader:
                     self._check_complete(index, last_time)
                     break
         finally:
-            stop.set()
-            while worker.is_alive():
-                try:  # unblock the producer if it waits on a full queue
-                    q.get_nowait()
-                except queue.Empty:
-                    worker.join(timeout=0.05)
+            self._stop_worker()
         if index == 0:
             raise WallcliError(f"{self.source}: no frames could be decoded")
 
@@ -334,7 +331,25 @@ class VideoReader:
         self.warnings.append(message)
         warnings.warn(message, VideoWarning, stacklevel=2)
 
+    def _stop_worker(self) -> None:
+        """Stop the decoder thread and wait for it. A consumer that raises inside its ``for frame``
+        loop leaves the frames() generator suspended (its ``finally`` runs only when it is
+        collected), so close() must do this too: closing the container while the thread is
+        inside FFmpeg (GIL released) would free it under the decoder's feet."""
+        worker = getattr(self, "_worker", None)
+        if worker is None:
+            return
+        thread, q, stop = worker
+        stop.set()
+        while thread.is_alive():
+            try:  # unblock the producer if it waits on a full queue
+                q.get_nowait()
+            except queue.Empty:
+                thread.join(timeout=0.05)
+        self._worker = None
+
     def close(self) -> None:
+        self._stop_worker()
         if self._container is not None:
             self._container.close()
             self._container = None

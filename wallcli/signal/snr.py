@@ -124,9 +124,11 @@ class Lattice:
         while math.ceil(my / step) * math.ceil(mx / step) > want and step < max(my, mx):
             step += 1
         nty, ntx = math.ceil(my / step), math.ceil(mx / step)
-        # Centre the lattice in the ROI so the margins on both sides are alike.
-        oy = y + ((h - ((nty - 1) * step + 1) * TILE) // 2)
-        ox = x + ((w - ((ntx - 1) * step + 1) * TILE) // 2)
+        # Centre the lattice in the ROI so the margins on both sides are alike; the margin is a
+        # multiple of 4 so the tiles stay on whole chroma samples of the snapped ROI (4:2:0, 4:1:1),
+        # or view() would pair luma rows with the chroma sample of their neighbours.
+        oy = y + ((h - ((nty - 1) * step + 1) * TILE) // 8) * 4
+        ox = x + ((w - ((ntx - 1) * step + 1) * TILE) // 8) * 4
         return cls(roi, nty, ntx, TILE, TILE, step * TILE, step * TILE, oy, ox)
 
     def view(self, plane: np.ndarray, fy: int = 1, fx: int = 1) -> np.ndarray:

@@ -99,12 +99,18 @@ def compute_stplot(
     if mean not in MODES:
         raise ValueError(f"mean must be one of {MODES}")
     info = reader.info
-    roi = check_roi(roi, info.width, info.height)
+    requested = roi
+    frame_size = [info.width, info.height]
+    roi = check_roi(requested, info.width, info.height)
     reduce = RowReducer(roi, bins)
     h_rows, v_rows, times = _Growing((bins, 3)), _Growing((bins, 3)), _Growing((), np.float64)
     for frame in reader.frames():
         if frame.index == 0 and (frame.planes.width, frame.planes.height) != (info.width, info.height):
-            roi = check_roi(roi, frame.planes.width, frame.planes.height)
+            # the container's size was wrong or unknown (some streams): the decoded frame decides,
+            # and the default ROI is then the whole decoded frame, not the announced one
+            frame_size = [frame.planes.width, frame.planes.height]
+            roi = check_roi(requested, *frame_size)
+            reduce = RowReducer(roi, bins)
         h, v = reduce(frame.planes)
         h_rows.append(h)
         v_rows.append(v)
@@ -118,7 +124,7 @@ def compute_stplot(
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
         "source": str(info.source),
-        "frame_size": [info.width, info.height],
+        "frame_size": frame_size,
         "fps": float(info.fps),
         "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}",
         "frames": times.n,
