@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Reproduce the shipped models from nothing: simulate the training sets and the shifted
 # validation sets (other seeds, moved room/people/camera ranges), train, export ONNX + cards.
-#   bash models/train.sh            # N=3200 windows per task, as shipped
+#   bash models/train.sh            # N=2048 windows per task, as shipped
 # Steps resume: rerunning skips finished shards and continues training from checkpoints.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 W=${WALLCLI:-.venv/bin/wallcli}
 JOBS=${JOBS:-2}
-N=${N:-3200}
-NVAL=${NVAL:-512}
+N=${N:-2048}
+NVAL=${NVAL:-384}
 EPOCHS_COUNT=${EPOCHS_COUNT:-12}
 EPOCHS_ACTIVITY=${EPOCHS_ACTIVITY:-12}
 
