@@ -15,7 +15,8 @@ from wallcli.cli.common import ROI_HELP, input_argument, parse_roi
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 STRIDE_OPT = typer.Option(None, "--stride", min=1, help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
 JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see CONTRACT.md).")
-PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG.")
+PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
+                        "(for a video, the plot drawn is averaged down to at most 2048 time columns).")
 MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
 THREADS_OPT = typer.Option(0, "--threads", min=0, help="onnxruntime intra-op threads (0: onnxruntime chooses).")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
@@ -36,10 +37,10 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
 
     from wallcli.cli.output import emit_json, print_table, progress
     from wallcli.infer.model import load_model
-    from wallcli.io.writer import check_output
+    from wallcli.io.writer import check_outputs
 
-    if plot is not None:
-        check_output(plot, force=force, inputs=[input])
+    # the model is an input too: --plot over it must not replace it
+    check_outputs([plot], force=force, inputs=[input, model_path])
     model = load_model(task, model_path, threads=threads)
     stride = int(stride or model.card["stride"])
 
@@ -50,11 +51,17 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
             emit_json(rec)
         return
 
-    from wallcli.infer.classify import classify_plot, load_plot
+    from wallcli.infer.classify import classify_plot, classify_video, load_plot
 
-    with progress(task, None, enabled=not str(input).lower().endswith(".npz")) as advance:
-        st = load_plot(input, roi=roi_t, bins=model.bins, progress=advance)
-    result = classify_plot(model, st, stride=stride, source=str(input))
+    if str(input).lower().endswith(".npz"):
+        st = load_plot(input, roi=roi_t, bins=model.bins)
+        result = classify_plot(model, st, stride=stride, source=str(input))
+    else:
+        # a video is decoded once and classified window by window: memory does not grow with its
+        # length (--plot keeps a copy of bounded size for drawing, see classify_video)
+        with progress(task, None) as advance:
+            result, st = classify_video(model, input, stride=stride, roi=roi_t,
+                                        progress=advance, keep_plot=plot is not None)
     if plot is not None:
         from wallcli.plots.timeline import save_timeline_png
 

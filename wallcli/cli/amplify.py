@@ -82,6 +82,8 @@ def amplify(
         raise UsageError(f"OUTPUT must end in {', '.join(VIDEO_SUFFIXES)} (got {output})")
     roi_t = parse_roi(roi)
 
+    import itertools
+
     import numpy as np
 
     from wallcli.cli.output import console_err, emit_json, progress
@@ -94,7 +96,12 @@ def amplify(
     check_output(output, force=force, inputs=[input])
     with open_video(input, threads=threads) as reader:
         info = reader.info
-        roi_t = check_roi(roi_t, info.width, info.height)
+        frames_in = reader.frames()
+        first = next(frames_in, None)
+        # the decoded frame decides the size, not the container's (wrong or unknown in some
+        # streams), as in compute_stplot
+        size = (first.planes.width, first.planes.height) if first is not None else (info.width, info.height)
+        roi_t = check_roi(roi_t, *size)
         _, _, rw, rh = roi_t
         pw, ph = parse_scale(scale, rw, rh)
         rows, cols = grid_shape(rw, rh, cells)
@@ -114,7 +121,7 @@ def amplify(
                         writer.write(right if left is None else np.concatenate([left, right], axis=1))
 
                 with progress("amplify", info.frame_count) as advance:
-                    for frame in reader.frames():
+                    for frame in itertools.chain([first] if first is not None else [], frames_in):
                         planes = frame.planes
                         if amp is None:
                             depth = planes.depth

@@ -143,13 +143,11 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
     import json
 
     from wallcli.cli.output import emit_json, progress
-    from wallcli.io.writer import VideoWriter, atomic_path, check_output
+    from wallcli.io.writer import VideoWriter, atomic_paths, check_outputs
     from wallcli.sim.camera import video_pix_fmt
 
     sidecar = output.with_suffix(".json")
-    for out in (output, sidecar, preview):
-        if out is not None:
-            check_output(out, force=force)
+    check_outputs([output, sidecar, preview], force=force)
     overrides = {k: v for k, v in dict(level=level, gain=iso_gain, read_noise=read_noise, prnu=prnu, gamma=gamma, drift=drift,
                                          flicker=flicker, mains=mains, ae_steps=ae_steps, shake=shake).items() if v is not None}
     overrides["sensor_pixels"] = float(sensor_pixels) if sensor_pixels else float(w * h)
@@ -170,16 +168,18 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         scene = sample_scene(seed, cfg)
     n = len(scene.times)
     pix_fmt = video_pix_fmt(scene.camera) if suffix != ".y4m" else None
-    with atomic_path(output, force=force) as tmp:
-        with VideoWriter(tmp, fps, w, h, codec=None if codec == "rawvideo" else codec, crf=crf, pix_fmt=pix_fmt) as vw:
+    # video and ground truth appear together or not at all (the sidecar is renamed first, so a
+    # video that is there always has its truth beside it)
+    with atomic_paths([sidecar, output], force=force) as (tmp_truth, tmp_video):
+        with VideoWriter(tmp_video, fps, w, h, codec=None if codec == "rawvideo" else codec, crf=crf,
+                         pix_fmt=pix_fmt) as vw:
             with progress("simulate", n) as advance:
                 for frame in scene.frames():
                     vw.write(frame)
                     advance(1)
-    truth = scene.truth()
-    truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
-    with atomic_path(sidecar, force=force) as tmp:
-        tmp.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
+        truth = scene.truth()
+        truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
+        tmp_truth.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
     if preview is not None:
         from wallcli.io.video import open_video
         from wallcli.plots.scene import save_preview

@@ -102,15 +102,13 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     from wallcli.cli.output import emit_json, print_table, progress, warn
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
-    from wallcli.io.writer import check_output
+    from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.snr import CHANNELS, GridAccumulator, SnrAccumulator, snr_db
 
     auto = roi is not None and roi.strip().lower() == "auto"
     roi_t = None if auto else parse_roi(roi)
-    for out in (heatmap, plot):
-        if out is not None:
-            check_output(out, force=force, inputs=[input])
+    check_outputs([heatmap, plot], force=force, inputs=[input])
     if auto and (input == "-" or not Path(input).exists()):
         raise WallcliError("--roi auto reads the video twice, so it needs a file (not '-' or a stream)"
                            if input == "-" or "://" in input else f"no such file: {input}")

@@ -53,12 +53,10 @@ def stplot(
     from wallcli.cli.output import emit_json, progress
     from wallcli.io.arrays import save_npz
     from wallcli.io.video import open_video
-    from wallcli.io.writer import check_output
+    from wallcli.io.writer import check_outputs
     from wallcli.signal.stplot import compute_stplot, to_arrays
 
-    for out in (output, png):
-        if out is not None:
-            check_output(out, force=force, inputs=[input])
+    check_outputs([output, png], force=force, inputs=[input])
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
             plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)

@@ -63,15 +63,14 @@ def train(
     from wallcli.cli.output import console_err, log
     from wallcli.errors import UsageError
     from wallcli.infer.card import card_path
-    from wallcli.io.writer import check_output
+    from wallcli.io.writer import check_outputs
     from wallcli.train.augment import DESCRIPTION
     from wallcli.train.export import export_model
     from wallcli.train.loop import TrainConfig, train as run_training
 
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
-    check_output(out, force=force)
-    check_output(card_path(out), force=force)
+    check_outputs([out, card_path(out)], force=force)
     cfg = TrainConfig(task=task.value, data=data, out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,

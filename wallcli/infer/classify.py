@@ -17,7 +17,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from wallcli.errors import WallcliError
-from wallcli.signal.window import StreamResampler, StreamWindower, normalize_window, resample, window_starts
+from wallcli.signal.window import StreamWindower, normalize_window, resample, window_starts
 
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
 
@@ -45,20 +45,8 @@ def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
     return out, grid
 
 
-def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
-    """The CONTRACT.md result for a whole space-time plot."""
-    plots, grid = resampled_plots(model, plot)
-    frames = len(grid) if plot.frames >= 2 else plot.frames
-    starts = window_starts(frames, model.window, stride)
-    if not starts:
-        raise _too_short(source, frames, model)
-    probs = []
-    for i in range(0, len(starts), CHUNK):
-        chunk = starts[i:i + CHUNK]
-        feed = {name: normalize_window(np.stack([p[:, s:s + model.window] for s in chunk]))
-                for name, p in plots.items()}
-        probs.append(model.predict(feed))
-    probs = np.concatenate(probs)
+def _result(model, times, probs, *, stride: int, source: str) -> dict[str, Any]:
+    """The CONTRACT.md result from window start times and their probabilities (n, classes)."""
     clip = probs.mean(axis=0)
     clip = clip / clip.sum()
     return {
@@ -71,12 +59,87 @@ def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
         "probabilities": [float(p) for p in clip],
         "stride": int(stride),
         "window": model.window,
-        "windows": [_window_record(model, grid[s], pr) for s, pr in zip(starts, probs)],
+        "windows": [_window_record(model, t, pr) for t, pr in zip(times, probs)],
     }
 
 
+def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
+    """The CONTRACT.md result for a whole space-time plot (a .npz file, already in memory)."""
+    plots, grid = resampled_plots(model, plot)
+    frames = len(grid) if plot.frames >= 2 else plot.frames
+    starts = window_starts(frames, model.window, stride)
+    if not starts:
+        raise _too_short(source, frames, model)
+    probs = []
+    for i in range(0, len(starts), CHUNK):
+        chunk = starts[i:i + CHUNK]
+        feed = {name: normalize_window(np.stack([p[:, s:s + model.window] for s in chunk]))
+                for name, p in plots.items()}
+        probs.append(model.predict(feed))
+    return _result(model, [grid[s] for s in starts], np.concatenate(probs), stride=stride, source=source)
+
+
+def _predict_window(model, win: np.ndarray) -> np.ndarray:
+    """Probabilities of one (2*bins, window, 3) window, horizontal rows first."""
+    b = model.bins
+    parts = {"horizontal": win[:b], "vertical": win[b:]}
+    return model.predict({n: normalize_window(parts[n][None]) for n in model.input_names})[0]
+
+
+def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
+                   keep_plot: bool = False):
+    """(result, plot) for a video, decoded once into windows classified as they complete.
+
+    Gives the windows of :func:`classify_plot` on the same video (the end-aligned last one
+    included), while holding only the last ``model.window`` resampled rows.  ``plot`` (for
+    ``--plot``) is None unless ``keep_plot``; then it is a :class:`PlotThumbnail` copy of at most
+    2048 time columns, enough to draw, not the full plot.
+    """
+    from wallcli.io.video import open_video
+    from wallcli.infer.stream import PlotThumbnail, RowStream
+
+    windower = StreamWindower(model.window, stride)
+    thumb = PlotThumbnail() if keep_plot else None
+    times, probs, emitted = [], [], 0  # emitted: rows seen when the newest window was classified
+    with open_video(source, threads=threads) as reader:
+        rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, progress=progress)
+        for t, row in rows:
+            if thumb is not None:
+                thumb.push(t, row)
+            done = windower.push(t, row)
+            if done is not None:
+                times.append(done[0])
+                probs.append(_predict_window(model, done[2]))
+                emitted = windower.count
+    last = windower.last()
+    if last is None:
+        raise _too_short(str(source), windower.count, model)
+    if emitted != windower.count:  # window_starts' end-aligned window: the last `window` rows
+        times.append(last[0])
+        probs.append(_predict_window(model, last[2]))
+    result = _result(model, times, np.stack(probs), stride=stride, source=str(source))
+    return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
+
+
+def _thumb_plot(thumb, rows, model):
+    from wallcli.signal.stplot import StPlot
+
+    b = model.bins
+    cols, t = thumb.columns()
+    mean = thumb.mean()
+    x = (cols - mean).transpose(1, 0, 2).astype(np.float32)  # clip mean removed, as compute_stplot
+    raw_mean = (mean + rows.ref).astype(np.float32)
+    meta = {"source": str(rows.reader.info.source), "roi": list(rows.roi), "bins": b, "fps": float(model.fps),
+            "downsample": thumb.factor}
+    return StPlot(np.ascontiguousarray(x[:b]), np.ascontiguousarray(x[b:]), t, raw_mean[:b], raw_mean[b:], meta)
+
+
 def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64, progress=None):
-    """A space-time plot from a ``wallcli stplot`` .npz or from any video input."""
+    """A space-time plot from a ``wallcli stplot`` .npz or from any video input.
+
+    The whole plot is in memory: the CLI classifies videos with :func:`classify_video`
+    instead; the video case stays as the reference that the streaming path is tested against.
+    """
     if str(source).lower().endswith(".npz"):
         from wallcli.io.arrays import load_npz
         from wallcli.signal.stplot import FORMAT, from_arrays
@@ -96,31 +159,17 @@ def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64,
 def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> Iterator[dict[str, Any]]:
     """One result per window, yielded as soon as its last frame is decoded.
 
-    Rows are the raw (not mean-removed) plot rows: ``normalize_window`` removes each
-    window's own mean, so no clip mean, which a live stream does not have, is needed.
+    Rows are raw (not clip-mean-removed): ``normalize_window`` removes each window's own
+    mean, so no clip mean, which a live stream does not have, is needed.
     """
     from wallcli.io.video import open_video
-    from wallcli.signal.blocks import check_roi
-    from wallcli.signal.stplot import RowReducer
+    from wallcli.infer.stream import RowStream
 
-    names = model.input_names
-    b = model.bins
+    windower = StreamWindower(model.window, stride)
     with open_video(source, threads=threads) as reader:
-        info = reader.info
-        reduce = RowReducer(check_roi(roi, info.width, info.height), b)
-        resampler = StreamResampler(model.fps)
-        windower = StreamWindower(model.window, stride)
-        rows = 0
-        for frame in reader.frames():
-            h, v = reduce(frame.planes)
-            for t, row in resampler.push(frame.time, np.concatenate([h, v])):
-                rows += 1
-                done = windower.push(t, row)
-                if done is None:
-                    continue
-                start, _, win = done  # win: (2*bins, window, 3), horizontal rows first
-                parts = {"horizontal": win[:b], "vertical": win[b:]}
-                feed = {n: normalize_window(parts[n][None]) for n in names}
-                yield _window_record(model, start, model.predict(feed)[0])
-        if rows < model.window:
-            raise _too_short(str(source), rows, model)
+        for t, row in RowStream(reader, roi=roi, bins=model.bins, fps=model.fps):
+            done = windower.push(t, row)
+            if done is not None:
+                yield _window_record(model, done[0], _predict_window(model, done[2]))
+    if windower.count < model.window:
+        raise _too_short(str(source), windower.count, model)

@@ -45,6 +45,21 @@ def check_output(path: str | os.PathLike, *, force: bool = False, inputs: Iterab
     return out
 
 
+def check_outputs(paths: Iterable, *, force: bool = False, inputs: Iterable = ()) -> list[Path]:
+    """:func:`check_output` for each of a command's outputs (None = not asked for), and refuse
+    two outputs on one file: the second write would silently replace the first (even without
+    --force, as the first one exists by then), after all the work was done."""
+    from wallcli.errors import UsageError
+
+    outs = [Path(p) for p in paths if p is not None]
+    for i, out in enumerate(outs):
+        for other in outs[:i]:
+            if _same_file(out, other):
+                raise UsageError(f"{out} is given for two outputs; each output needs its own file")
+    inputs = list(inputs)
+    return [check_output(out, force=force, inputs=inputs) for out in outs]
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike, *, force: bool = False) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same suffix, so muxers pick the right format).
@@ -52,21 +67,43 @@ def atomic_path(path: str | os.PathLike, *, force: bool = False) -> Iterator[Pat
     On success it is fsynced and renamed over ``path``; on any exception (Ctrl-C included) it is
     removed, so a crash never leaves a half-written output.
     """
-    out = Path(path)
-    check_output(out, force=force)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=f".tmp{out.suffix}", dir=out.parent or ".")
-    os.close(fd)
-    tmp = Path(tmp_name)
-    os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
-    try:
+    with atomic_paths([path], force=force) as (tmp,):
         yield tmp
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        if out.exists() and not force:  # someone else created it while we worked
-            raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
-        os.replace(tmp, out)
+
+
+@contextmanager
+def atomic_paths(paths: Iterable, *, force: bool = False) -> Iterator[list[Path]]:
+    """:func:`atomic_path` for outputs that only make sense together (a video and its ground truth).
+
+    Every temporary is written first; then they are renamed in the order given, so list last
+    the file readers look for (the video: once it is there, its sidecar is too). If anything
+    fails, renames included, none of the outputs is left.
+    """
+    outs = [Path(p) for p in paths]
+    tmps: list[Path] = []
+    placed: list[Path] = []
+    try:
+        for out in outs:
+            check_output(out, force=force)
+            fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=f".tmp{out.suffix}", dir=out.parent or ".")
+            os.close(fd)
+            tmps.append(Path(tmp_name))
+            os.chmod(tmp_name, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
+        yield list(tmps)
+        for tmp in tmps:
+            with open(tmp, "rb+") as fh:
+                os.fsync(fh.fileno())
+        for out in outs:
+            if out.exists() and not force:  # someone else created it while we worked
+                raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
+        for tmp, out in zip(tmps, outs):
+            os.replace(tmp, out)
+            placed.append(out)
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        for tmp in tmps:
+            tmp.unlink(missing_ok=True)
+        for out in placed:  # half a pair is worse than none (a video without its ground truth)
+            out.unlink(missing_ok=True)
         raise
 
 

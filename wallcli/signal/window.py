@@ -62,28 +62,32 @@ def normalize_window(x: np.ndarray) -> np.ndarray:
 
 
 class StreamResampler:
-    """Online version of :func:`resample` for live input: push timestamped rows, get 30 fps rows."""
+    """Online version of :func:`resample` for live input: push timestamped rows, get 30 fps rows.
+
+    Grid times are ``t0 + k / fps`` with the same end tolerance as :func:`resample` (not a running
+    sum, which drifts), so a stream yields exactly the rows the batch path computes.
+    """
 
     def __init__(self, fps: float = CANONICAL_FPS):
         self.fps = float(fps)
         self._prev = None  # (t, row)
-        self._next_t = None
+        self._t0 = None
+        self._k = 0  # index of the next grid time
 
     def push(self, t: float, row: np.ndarray) -> Iterator[tuple[float, np.ndarray]]:
         row = np.asarray(row, np.float32)
         if self._prev is None:
-            self._prev = (t, row)
-            self._next_t = t
+            self._prev, self._t0, self._k = (t, row), t, 1
             yield t, row
-            self._next_t = t + 1.0 / self.fps
             return
         t0, r0 = self._prev
         if t <= t0:
             return
-        while self._next_t <= t + 1e-9:
-            w = np.float32((self._next_t - t0) / (t - t0))
-            yield self._next_t, r0 * (1 - w) + row * w
-            self._next_t += 1.0 / self.fps
+        while self._k <= (t - self._t0) * self.fps + 1e-6:
+            g = self._t0 + self._k / self.fps
+            w = np.float32(min(max((g - t0) / (t - t0), 0.0), 1.0))
+            yield g, r0 * (1 - w) + row * w
+            self._k += 1
         self._prev = (t, row)
 
 
@@ -105,5 +109,19 @@ class StreamWindower:
         self._since += 1
         if self._count >= self.window and (self._count == self.window or self._since >= self.stride):
             self._since = 0
-            return self._times[0], self._times[-1], np.stack(self._rows, axis=1)
+            return self.last()
         return None
+
+    @property
+    def count(self) -> int:
+        return self._count
+
+    def last(self):
+        """The newest full window (start, end, window), emitted or not; None before ``window`` rows.
+
+        The batch path's final window is aligned to the end of the clip: at the end of a stream
+        it is this one (the buffer holds exactly the last ``window`` rows).
+        """
+        if self._count < self.window:
+            return None
+        return self._times[0], self._times[-1], np.stack(self._rows, axis=1)
