@@ -10,7 +10,7 @@ if [ ! -x .venv/bin/wallcli ]; then
   .venv/bin/python -m pip install -q .
 fi
 w=.venv/bin/wallcli
-clip=${1:-examples/one_walking.mp4}
+clip=${1:-examples/walking.mp4}
 out=examples/out
 mkdir -p "$out"
 
