@@ -95,8 +95,10 @@ def _line_sums(plane: np.ndarray, axis: int) -> np.ndarray:
     """Exact integer sums along ``axis`` (0: one sum per column, 1: one per row), as float64."""
     import cv2
 
-    if plane.dtype == np.uint8 and plane.shape[axis] < (1 << 23):
-        return cv2.reduce(plane, axis, cv2.REDUCE_SUM, dtype=cv2.CV_32S).ravel().astype(np.float64)
+    if plane.dtype == np.uint8 and plane.shape[axis] * 255 < (1 << 24):
+        # float32 holds every integer below 2^24 exactly, so these sums are exact, and OpenCV's
+        # float accumulation is twice as fast as its int32 one.
+        return cv2.reduce(plane, axis, cv2.REDUCE_SUM, dtype=cv2.CV_32F).ravel().astype(np.float64)
     return plane.sum(axis=axis, dtype=np.uint64).astype(np.float64)
 
 
