@@ -42,7 +42,7 @@ def evaluate(task: str, data: str, model_path: str | None = None) -> dict:
         if sel.any():
             buckets.append({"snr_db": [lo, hi], "windows": int(sel.sum()), "accuracy": float((pred[sel] == y[sel]).mean())})
     return {
-        "task": task, "data": data, "model": model.info, "windows": int(len(y)),
+        "task": task, "data": data, "model": model.info(), "windows": int(len(y)),
         "accuracy": float((pred == y).mean()),
         "classes": model.classes,
         "confusion_matrix": cm.tolist(),
@@ -61,7 +61,9 @@ def main() -> None:
     a = ap.parse_args()
     r = evaluate(a.task, a.data, a.model)
     if a.json:
-        print(json.dumps(r, default=lambda v: None if v in (np.inf, -np.inf) else v))
+        from wallcli.cli.output import to_json  # infinities (open SNR buckets) become null
+
+        print(to_json(r))
         return
     print(f"{a.task} on {a.data}: accuracy {r['accuracy']:.1%} over {r['windows']} windows")
     print("confusion (rows true, columns predicted):", r["classes"])

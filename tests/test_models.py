@@ -1,0 +1,47 @@
+"""The shipped models: golden outputs on a seeded clip through the whole run-time path.
+
+(The v0.1 models do not yet give the true answers on examples/: see models/README.md.)"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+GOLDEN = Path(__file__).resolve().parent / "golden"
+
+
+@pytest.fixture(scope="module")
+def golden_clip(tmp_path_factory):
+    from wallcli.cli.app import main
+
+    clip = tmp_path_factory.mktemp("golden") / "golden.mp4"
+    spec = json.loads((GOLDEN / "count.json").read_text())["clip"]
+    try:
+        main(["simulate", "-o", str(clip), *spec])
+    except SystemExit as exc:
+        assert exc.code in (0, None)
+    return clip
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
+def test_golden_outputs(task, golden_clip, run_cli):
+    golden = json.loads((GOLDEN / f"{task}.json").read_text())
+    code, out, err = run_cli(task, golden_clip, "--json")
+    assert code == 0, err
+    r = json.loads(out)
+    assert r["model"]["sha256"] == golden["sha256"], "the shipped model changed: run tests/golden/make_golden.py"
+    assert r["label"] == golden["label"]
+    assert [w["start"] for w in r["windows"]] == pytest.approx([w["start"] for w in golden["windows"]], abs=1e-6)
+    got = np.array([w["probabilities"] for w in r["windows"]])
+    want = np.array([w["probabilities"] for w in golden["windows"]])
+    assert np.allclose(got, want, atol=1e-4)
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
+def test_corrupt_plot_file(tmp_path, run_cli, task):
+    bad = tmp_path / "plots.npz"
+    bad.write_bytes(b"PK\x03\x04 not really a zip")
+    code, out, err = run_cli(task, bad, "--json")
+    assert code == 1 and out == ""
+    assert len(err.strip().splitlines()) == 1 and err.startswith("Error:") and "npz" in err
