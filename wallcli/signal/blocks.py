@@ -102,11 +102,44 @@ def _line_sums(plane: np.ndarray, axis: int) -> np.ndarray:
     return plane.sum(axis=axis, dtype=np.uint64).astype(np.float64)
 
 
-def _bin_sums(values: np.ndarray, origin: int, edges: np.ndarray) -> np.ndarray:
-    """Sums of per-pixel ``values`` (pixel k covers [origin+k, origin+k+1)) over fractional edges."""
-    cum = np.concatenate([[0.0], np.cumsum(values)])
-    at = np.interp(np.asarray(edges, np.float64) - origin, np.arange(cum.size), cum)
-    return np.diff(at)
+def _coverage(origin: int, n: int, edges: np.ndarray) -> np.ndarray:
+    """(bins, n) matrix: the share of each bin [e_b, e_b+1) covered by pixel k = [origin+k, origin+k+1),
+    divided by the bin's width, so that ``matrix @ per_pixel_sums`` gives per-bin means."""
+    lo = origin + np.arange(n, dtype=np.float64)
+    e = np.asarray(edges, np.float64)
+    overlap = np.clip(np.minimum(lo[None, :] + 1, e[1:, None]) - np.maximum(lo[None, :], e[:-1, None]), 0.0, None)
+    return overlap / np.diff(e)[:, None]
+
+
+class ProjectionPlan:
+    """Exact means over a rectangle of one plane, binned two ways (see :func:`projection_means`).
+
+    The binning matrices depend only on the geometry, so a stream builds the plan once and each
+    frame costs two ``cv2.reduce`` passes and two small matrix-vector products.
+    """
+
+    def __init__(self, row_edges: np.ndarray, col_edges: np.ndarray):
+        self.r0, self.r1 = float(row_edges[0]), float(row_edges[-1])
+        self.c0, self.c1 = float(col_edges[0]), float(col_edges[-1])
+        self.ri0, self.ri1 = int(np.floor(self.r0)), int(np.ceil(self.r1))
+        self.ci0, self.ci1 = int(np.floor(self.c0)), int(np.ceil(self.c1))
+        self.col_bins = _coverage(self.ci0, self.ci1 - self.ci0, col_edges) / (self.r1 - self.r0)
+        self.row_bins = _coverage(self.ri0, self.ri1 - self.ri0, row_edges) / (self.c1 - self.c0)
+
+    def __call__(self, plane: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        sub = plane[self.ri0:self.ri1, self.ci0:self.ci1]
+        col = _line_sums(sub, 0)
+        row = _line_sums(sub, 1)
+        # Pixels cut by a fractional edge count by the fraction of them inside the rectangle.
+        if self.r0 > self.ri0:
+            col -= (self.r0 - self.ri0) * sub[0].astype(np.float64)
+        if self.ri1 > self.r1:
+            col -= (self.ri1 - self.r1) * sub[-1].astype(np.float64)
+        if self.c0 > self.ci0:
+            row -= (self.c0 - self.ci0) * sub[:, 0].astype(np.float64)
+        if self.ci1 > self.c1:
+            row -= (self.ci1 - self.c1) * sub[:, -1].astype(np.float64)
+        return self.col_bins @ col, self.row_bins @ row
 
 
 def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -117,36 +150,35 @@ def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.nda
     Equal to averaging ``block_means`` over one axis, with two cheap reductions instead of an
     integral image (about 8x faster on 1080p; this is stplot's per-frame cost).
     """
-    r0, r1 = float(row_edges[0]), float(row_edges[-1])
-    c0, c1 = float(col_edges[0]), float(col_edges[-1])
-    ri0, ri1, ci0, ci1 = int(np.floor(r0)), int(np.ceil(r1)), int(np.floor(c0)), int(np.ceil(c1))
-    sub = plane[ri0:ri1, ci0:ci1]
-    col = _line_sums(sub, 0)
-    row = _line_sums(sub, 1)
-    # Pixels cut by a fractional edge count by the fraction of them inside the rectangle.
-    if r0 > ri0:
-        col -= (r0 - ri0) * sub[0].astype(np.float64)
-    if ri1 > r1:
-        col -= (ri1 - r1) * sub[-1].astype(np.float64)
-    if c0 > ci0:
-        row -= (c0 - ci0) * sub[:, 0].astype(np.float64)
-    if ci1 > c1:
-        row -= (ci1 - c1) * sub[:, -1].astype(np.float64)
-    cols = _bin_sums(col, ci0, col_edges) / ((r1 - r0) * np.diff(col_edges))
-    rows = _bin_sums(row, ri0, row_edges) / ((c1 - c0) * np.diff(row_edges))
-    return cols, rows
+    return ProjectionPlan(row_edges, col_edges)(plane)
+
+
+class RgbProjector:
+    """Per frame: the horizontal and vertical RGB profiles (bins, 3) of ``roi``, float64, 0-255.
+
+    Plans are built for the first frame's plane geometry and rebuilt only if it changes.
+    """
+
+    def __init__(self, roi: Roi, bins: int):
+        x, y, w, h = roi
+        self.rows = bin_edges(y, y + h, bins)
+        self.cols = bin_edges(x, x + w, bins)
+        self._key = None
+
+    def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
+        key = (planes.u is None, planes.sub_x, planes.sub_y)
+        if key != self._key:
+            self._key = key
+            self._luma = ProjectionPlan(self.rows, self.cols)
+            self._chroma = ProjectionPlan(self.rows / (1 << planes.sub_y), self.cols / (1 << planes.sub_x))
+        yc, yr = self._luma(planes.y)
+        if planes.u is None:
+            return planes.to_rgb(yc).astype(np.float64), planes.to_rgb(yr).astype(np.float64)
+        uc, ur = self._chroma(planes.u)
+        vc, vr = self._chroma(planes.v)
+        return planes.to_rgb(yc, uc, vc).astype(np.float64), planes.to_rgb(yr, ur, vr).astype(np.float64)
 
 
 def rgb_projections(planes, roi: Roi, bins: int) -> tuple[np.ndarray, np.ndarray]:
     """The horizontal and vertical RGB profiles (bins, 3) of ``roi``, float64, 0-255 scale."""
-    x, y, w, h = roi
-    rows = bin_edges(y, y + h, bins)
-    cols = bin_edges(x, x + w, bins)
-    yc, yr = projection_means(planes.y, rows, cols)
-    if planes.u is None:
-        return planes.to_rgb(yc).astype(np.float64), planes.to_rgb(yr).astype(np.float64)
-    crow = rows / (1 << planes.sub_y)
-    ccol = cols / (1 << planes.sub_x)
-    uc, ur = projection_means(planes.u, crow, ccol)
-    vc, vr = projection_means(planes.v, crow, ccol)
-    return planes.to_rgb(yc, uc, vc).astype(np.float64), planes.to_rgb(yr, ur, vr).astype(np.float64)
+    return RgbProjector(roi, bins)(planes)

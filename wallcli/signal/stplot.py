@@ -16,7 +16,7 @@ from typing import Callable, Iterable
 import numpy as np
 
 from wallcli import __version__
-from wallcli.signal.blocks import Roi, check_roi, rgb_projections
+from wallcli.signal.blocks import Roi, RgbProjector, check_roi
 from wallcli.signal.mean import MODES, remove_mean
 
 FORMAT = "wallcli.stplot"
@@ -47,9 +47,10 @@ class RowReducer:
 
     def __init__(self, roi: Roi, bins: int = 64):
         self.roi, self.bins = roi, int(bins)
+        self._project = RgbProjector(roi, self.bins)
 
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
-        return rgb_projections(planes, self.roi, self.bins)
+        return self._project(planes)
 
 
 class _Growing:
