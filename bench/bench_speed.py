@@ -56,13 +56,12 @@ def main() -> None:
     dec4 = best("decode", str(long_clip))
     dec_fps = args.frames / dec["seconds"]
     dec4_fps = 4 * args.frames / dec4["seconds"]
-    startup = measure("wallcli", "--version")
+    tiny = clip_1080p(3)  # a command on 3 frames costs its start-up: imports, model load
     load = os.getloadavg()[0]
     print(f"1080p30 H.264, {args.frames} frames (and {4 * args.frames} for memory), best of {args.repeat}; "
           f"load average {load:.1f} on {os.cpu_count()} cores")
-    print(f"  wallcli start-up (wallcli --version): {startup['seconds']:.2f} s, counted in every command below")
     print(f"  {'job':<8} {'frames/s':>9} {'x decode':>9} {'x decode (CPU)':>15} {'peak RSS':>9} "
-          f"{'4x clip: frames/s':>18} {'x decode':>9} {'peak RSS':>9}")
+          f"{'4x clip: frames/s':>18} {'x decode':>9} {'peak RSS':>9} {'start-up':>9} {'steady x decode':>16}")
     print(f"  {'decode':<8} {dec_fps:9.1f} {1.0:9.2f} {1.0:15.2f} {dec['peak_rss_mb']:7.0f}MB "
           f"{dec4_fps:18.1f} {1.0:9.2f} {dec4['peak_rss_mb']:7.0f}MB")
     for name, job in jobs.items():
@@ -71,10 +70,14 @@ def main() -> None:
             continue
         r = best(*(a.format(clip=clip) for a in job))
         r4 = best(*(a.format(clip=long_clip) for a in job))
+        r0 = best(*(a.format(clip=tiny) for a in job)) if name != "count" else None
         fps = args.frames / r["seconds"]
         fps4 = 4 * args.frames / r4["seconds"]
+        # Steady state: the long run without the command's fixed start-up cost.
+        steady = f"{(4 * args.frames - 3) / (r4['seconds'] - r0['seconds']) / dec4_fps:16.2f}" if r0 else f"{'(< 256 frames)':>16}"
+        start = f"{r0['seconds']:8.2f}s" if r0 else f"{'-':>9}"
         print(f"  {name:<8} {fps:9.1f} {fps / dec_fps:9.2f} {dec['cpu_seconds'] / r['cpu_seconds']:15.2f} "
-              f"{r['peak_rss_mb']:7.0f}MB {fps4:18.1f} {fps4 / dec4_fps:9.2f} {r4['peak_rss_mb']:7.0f}MB")
+              f"{r['peak_rss_mb']:7.0f}MB {fps4:18.1f} {fps4 / dec4_fps:9.2f} {r4['peak_rss_mb']:7.0f}MB {start} {steady}")
 
 
 if __name__ == "__main__":
