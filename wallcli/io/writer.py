@@ -115,7 +115,7 @@ def write_text_atomic(path: str | os.PathLike, text: str, *, force: bool = False
 class VideoWriter:
     """Encode RGB uint8 frames with PyAV.
 
-    ``.mp4``/``.mov`` -> H.264 (``crf``), ``.mkv`` with ``codec='ffv1'`` -> lossless FFV1,
+    ``.mp4``/``.mov`` -> H.264 (``crf``), ``.mkv`` with ``codec='ffv1'`` -> FFV1 4:4:4 (lossless after RGB->YUV),
     ``.y4m`` -> raw yuv. The caller owns atomicity (write to ``atomic_path``'s temp path).
     """
 
@@ -149,7 +149,9 @@ class VideoWriter:
             pix_fmt = pix_fmt or "yuv420p"
             stream.options = {"crf": str(crf), "preset": preset}
         elif codec == "ffv1":
-            pix_fmt = pix_fmt or "gbrp"  # planar RGB: truly lossless for rgb24 input
+            # (gbrp would be lossless RGB, but FFV1 in the PyAV wheels refuses it; 4:4:4 YUV
+            # loses only the rounding of the RGB->YUV conversion.)
+            pix_fmt = pix_fmt or "yuv444p"
         stream.width, stream.height = int(width), int(height)
         stream.pix_fmt = pix_fmt or "yuv420p"
         if stream.pix_fmt.startswith("yuv"):
