@@ -151,3 +151,18 @@ def test_close_stops_the_decoder_before_the_container(tmp_path):
                 raise KeyError("consumer failed")
     assert reader._worker is None
     assert not any(t.name == "wallcli-decode" and t.is_alive() for t in __import__("threading").enumerate())
+
+
+@pytest.mark.parametrize("name,codec", [("w.mp4", None), ("w.mkv", "ffv1"), ("w.y4m", None)])
+def test_writer_round_trip(tmp_path, name, codec):
+    from wallcli.io.writer import VideoWriter
+
+    frames = [np.full((32, 48, 3), (60 + 10 * i, 120, 180), np.uint8) for i in range(4)]
+    with VideoWriter(tmp_path / name, Fraction(25), 48, 32, codec=codec, crf=0) as w:
+        for f in frames:
+            w.write(f)
+    with open_video(tmp_path / name) as reader:
+        assert reader.info.fps == Fraction(25)
+        got = [rgb_grid(f.planes, (0, 0, 48, 32), 1, 1)[0, 0] for f in reader.frames()]
+    assert len(got) == 4
+    assert np.abs(np.array(got) - np.array([f[0, 0] for f in frames])).max() < 1.5
