@@ -8,12 +8,12 @@ cd "$(dirname "$0")/.."
 W=${WALLCLI:-.venv/bin/wallcli}
 JOBS=${JOBS:-2}
 N=${N:-2048}
-EPOCHS_COUNT=${EPOCHS_COUNT:-14}
-EPOCHS_ACTIVITY=${EPOCHS_ACTIVITY:-7}
+EPOCHS_COUNT=${EPOCHS_COUNT:-20}
+EPOCHS_ACTIVITY=${EPOCHS_ACTIVITY:-11}
 
 $W simulate --dataset "$N" --task count -o data/count --jobs "$JOBS" --seed 1 --world mixed
 $W simulate --dataset 512 --task count -o data/val_count --jobs "$JOBS" --seed 101 --domain shifted
-$W train count --data data/count --val data/val_count --out models/count.onnx --epochs "$EPOCHS_COUNT" --threads 1 --min-snr-db -15 --model-version 0.1.0 --force
+$W train count --data data/count --val data/val_count --out models/count.onnx --epochs "$EPOCHS_COUNT" --threads 1 --min-snr-db -15 --model-version 0.1.1 --force
 
 $W simulate --dataset "$N" --task activity -o data/activity --jobs "$JOBS" --seed 2
 $W simulate --dataset 384 --task activity -o data/val_activity --jobs "$JOBS" --seed 102 --domain shifted
