@@ -58,17 +58,11 @@ def _root(
 
 
 def _register() -> None:
-    # Each command lives in its own module; a module that is not there yet simply adds nothing.
+    # One module per command; each imports only typer and the standard library at module level.
     import importlib
 
     for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train"):
-        try:
-            mod = importlib.import_module(f"wallcli.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"wallcli.cli.{name}":
-                continue
-            raise
-        app.command(name)(getattr(mod, name))
+        app.command(name)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
 
 
 _register()
