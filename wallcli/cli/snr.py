@@ -4,7 +4,7 @@ or, with ``--predict``, what the physics of seed §3 expects for a scene and cam
 from __future__ import annotations
 
 from pathlib import Path
-from typing import List, Optional
+from typing import Optional
 
 import typer
 

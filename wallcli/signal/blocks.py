@@ -177,8 +177,3 @@ class RgbProjector:
         uc, ur = self._chroma(planes.u)
         vc, vr = self._chroma(planes.v)
         return planes.to_rgb(yc, uc, vc).astype(np.float64), planes.to_rgb(yr, ur, vr).astype(np.float64)
-
-
-def rgb_projections(planes, roi: Roi, bins: int) -> tuple[np.ndarray, np.ndarray]:
-    """The horizontal and vertical RGB profiles (bins, 3) of ``roi``, float64, 0-255 scale."""
-    return RgbProjector(roi, bins)(planes)

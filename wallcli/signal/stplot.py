@@ -11,7 +11,7 @@ small plot equals removing it from every pixel first.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Iterable
+from typing import Callable
 
 import numpy as np
 
@@ -140,35 +140,6 @@ def compute_stplot(
         "warnings": list(getattr(reader, "warnings", [])),
     }
     return _finish(h_rows.array(), v_rows.array(), times.array(), meta, mean, mean_seconds)
-
-
-def stplot_from_rgb_frames(
-    frames: Iterable[np.ndarray], times: Iterable[float], *, roi: Roi | None = None, bins: int = 64,
-    mean: str = "clip", mean_seconds: float = 10.0,
-) -> StPlot:
-    """The same plots from float RGB arrays (H, W, 3) already in memory (simulations, tests)."""
-    from types import SimpleNamespace
-
-    h_rows, v_rows, ts = [], [], []
-    reduce = None
-    for rgb, t in zip(frames, times):
-        rgb = np.asarray(rgb)
-        planes = SimpleNamespace(
-            y=rgb[..., 0], u=rgb[..., 1], v=rgb[..., 2], sub_x=0, sub_y=0,
-            to_rgb=lambda r, g, b: np.stack([r, g, b], axis=-1),
-        )
-        if reduce is None:
-            reduce = RowReducer(check_roi(roi, rgb.shape[1], rgb.shape[0]), bins)
-        h, v = reduce(planes)
-        h_rows.append(h)
-        v_rows.append(v)
-        ts.append(float(t))
-    meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "source": "<arrays>", "bins": int(bins),
-            "mean": mean, "frames": len(ts), "roi": list(reduce.roi) if reduce else None,
-            "wallcli_version": __version__}
-    if len(ts) >= 2:
-        meta["fps"] = float((len(ts) - 1) / (ts[-1] - ts[0])) if ts[-1] > ts[0] else None
-    return _finish(np.asarray(h_rows), np.asarray(v_rows), np.asarray(ts), meta, mean, mean_seconds)
 
 
 def to_arrays(plot: StPlot) -> tuple[dict[str, np.ndarray], dict]:

@@ -180,7 +180,6 @@ class Camera:
     def render(self, E: np.ndarray, index: int, static_E: np.ndarray | None = None) -> np.ndarray:
         """uint8 (H, W, 3) frame for irradiance grid E. If ``static_E`` is given, E is the change
         from it (cheaper and more exact: the static image is already computed)."""
-        p = self.p
         lin = self.upsample(E)
         lin *= self.gain_k
         if static_E is not None:
