@@ -70,17 +70,31 @@ def test_train_command_end_to_end(make_dataset, tmp_path, capsys):
     card = read_card(out)
     assert card["task"] == "count" and card["classes"] == [0, 1, 2] and card["version"] == "0.1.0"
     assert card["sha256"] == sha256_file(out)
-    assert card["training_data"]["recipe"] == {"generator": "tests/train/conftest.py streaks"}
+    assert card["training_data"]["recipe"] == [{"generator": "tests/train/conftest.py streaks"}]
     assert card["training_data"]["windows"] == 20 and card["training"]["optimizer"] == "RMSprop"
     assert card["training"]["lr"] == 1e-3 and card["training"]["augmentation"]
     v = card["validation"]
     assert v["windows"] == 6 and np.array(v["confusion_matrix"]).shape == (3, 3)
     assert np.array(v["confusion_matrix"]).sum() == 6 and 0.0 <= v["accuracy"] <= 1.0
+    assert card["training"]["weight_average"] == {"ema_decay_per_step": 0.995, "exported": "last"}
+    assert card["validation"]["epoch"] == 1
     assert out.with_suffix(".ckpt.pt").is_file()
     assert capsys.readouterr().out == ""  # nothing but data on stdout
     # an existing model is never overwritten without --force, and the check comes before training
     assert run_cli(args) == 1
     assert "exists" in capsys.readouterr().err
+
+
+def test_train_on_two_folders(make_dataset, tmp_path):
+    a = make_dataset("count", 12)
+    b = make_dataset("count", 8, seed=5, shards=1, name="more")
+    out = tmp_path / "count.onnx"
+    args = ["train", "count", "--data", str(a), "--data", str(b), "--val-fraction", "0.25", "--out", str(out),
+            "--epochs", "1", "--batch-size", "4", "--threads", "1", "--ema", "0"]
+    assert run_cli(args) == 0
+    card = read_card(out)
+    assert card["training_data"]["windows"] == 20 and len(card["training_data"]["recipe"]) == 2
+    assert card["training_data"]["dataset"] == [str(a), str(b)]
 
 
 def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path):

@@ -86,6 +86,9 @@ def simulate(
     jobs: int = typer.Option(0, "--jobs", "-j", min=0, help="Dataset worker processes (0 = one per core)."),
     windows_per_scene: int = typer.Option(4, "--windows-per-scene", min=1, max=16, help="Overlapping windows cut from each rendered clip."),
     shard_scenes: int = typer.Option(32, "--shard-scenes", min=1, help="Scenes per shard file."),
+    placement: str = typer.Option("visible", "--placement", help="Dataset mode: where people go. visible: 0.8-4 m from the "
+                                  "wall, walkers within 1.5 m of the observed patch (their signal stands above the noise); "
+                                  "anywhere: 1-5 m, roaming 2.5 m, like single videos."),
 ) -> None:
     """Render synthetic blank-wall videos with known ground truth, or datasets for training.
 
@@ -114,7 +117,10 @@ def simulate(
             raise UsageError(f"--task must be count or activity (got {task!r})")
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
-        return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force, json_out)
+        if placement not in ("visible", "anywhere"):
+            raise UsageError(f"--placement must be visible or anywhere (got {placement!r})")
+        return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
+                        json_out, placement)
     if world == "mixed":
         raise UsageError("--world mixed is for --dataset; a single video is room or flatland")
     acts = [a.strip() for a in activity.split(",") if a.strip()]
@@ -194,7 +200,7 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
             "persons": [{k: v for k, v in p.items() if k != "positions"} for p in truth.get("persons", [])]})
 
 
-def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out) -> None:
+def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out, placement) -> None:
     import os
     import time
 
@@ -210,7 +216,7 @@ def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid
     t0 = time.perf_counter()
     with progress(f"dataset ({task})", n) as advance:
         manifest = build_dataset(output, n, task, seed=seed, jobs=jobs, domain=domain, world=world,
-                                 windows_per_scene=wps, shard_scenes=shard_scenes, grid=grid_rc, force=force,
+                                 windows_per_scene=wps, shard_scenes=shard_scenes, grid=grid_rc, force=force, placement=placement,
                                  advance=advance, log=lambda m: console_err.print(m))
     dt = time.perf_counter() - t0
     console_err.print(f"wrote {n} windows in {len(manifest['shards'])} shard(s) to {output} in {dt:.1f} s")

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from enum import Enum
 from pathlib import Path
-from typing import Optional
+from typing import List, Optional
 
 import typer
 
@@ -17,7 +17,8 @@ class Task(str, Enum):
 
 def train(
     task: Task = typer.Argument(..., help="Which network: 'count' (0/1/2 people) or 'activity'."),
-    data: Path = typer.Option(..., "--data", help="Dataset folder from the simulator (dataset.json + shards)."),
+    data: List[Path] = typer.Option(..., "--data", help="Dataset folder from the simulator (dataset.json + shards); "
+                                    "repeat it to train on several folders as one dataset."),
     out: Path = typer.Option(..., "--out", "-o", help="Model to write (.onnx); its card goes beside it (.json)."),
     val: Optional[Path] = typer.Option(None, "--val", help="Validation dataset folder (default: hold out --val-fraction of --data)."),
     val_fraction: float = typer.Option(0.1, "--val-fraction", min=0.0, max=0.5, help="Share of --data held out when there is no --val."),
@@ -36,15 +37,21 @@ def train(
                                                "noise-free signal is this many dB below the plot noise or more (per-window "
                                                "snr_db from the simulator); windows with nobody moving always stay. "
                                                "Validation keeps every window."),
+    ema: float = typer.Option(0.995, "--ema", min=0.0, max=0.9999, help="Per-step decay of the moving average of the "
+                              "weights that is validated and exported (0: the raw weights)."),
+    select: str = typer.Option("last", "--select", help="Export the weights after the last epoch ('last': the card's "
+                               "validation accuracy is then a plain measurement) or of the epoch with the best "
+                               "validation accuracy ('best')."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
 
     RMSProp (lr 1e-3) on cross-entropy, with label-preserving augmentation. A checkpoint is
     written every few minutes and after each epoch; running the same command again (or after
-    Ctrl-C / kill) resumes exactly where it stopped. The exported weights are those of the
-    epoch with the best validation accuracy; the card records the data recipe, the training
-    settings, the validation accuracy and confusion matrix, and the sha256 of the .onnx.
+    Ctrl-C / kill) resumes exactly where it stopped. A moving average of the weights (--ema)
+    is validated after every epoch and exported at the end (--select); the card records the
+    data recipe, the training settings, the validation accuracy and confusion matrix, and the
+    sha256 of the .onnx.
     Needs the optional extra: pip install torch==2.13.0 && pip install 'wallcli[train]'.
 
     \b
@@ -68,13 +75,15 @@ def train(
     from wallcli.train.export import export_model
     from wallcli.train.loop import TrainConfig, train as run_training
 
+    if select not in ("last", "best"):
+        raise UsageError(f"--select must be last or best (got {select!r})")
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     check_outputs([out, card_path(out)], force=force)
-    cfg = TrainConfig(task=task.value, data=data, out=out, val=val, val_fraction=val_fraction, epochs=epochs,
+    cfg = TrainConfig(task=task.value, data=list(data), out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
-                      min_snr_db=min_snr_db)
+                      min_snr_db=min_snr_db, ema=ema, select=select)
 
     _sigterm_interrupts()
     with _TrainProgress(console_err) as bar:
@@ -95,13 +104,14 @@ def train(
         }
     fields = dict(
         name=name or f"wallcli-{task.value}", version=model_version, task=task.value, classes=ds.classes, stride=stride,
-        training_data={"dataset": str(data), "recipe": ds.manifest.get("recipe"), "seed": ds.manifest.get("seed"),
+        training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
         training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
                   "loss": "cross-entropy", "augmentation": DESCRIPTION if augment else [],
+                  "weight_average": {"ema_decay_per_step": ema, "exported": select},
                   "selected_epoch": result["best_epoch"], "history": result["history"],
-                  "command": f"wallcli train {task.value} --data {data} --out {out} --epochs {epochs} "
-                             f"--batch-size {batch_size} --seed {seed}"
+                  "command": f"wallcli train {task.value} " + " ".join(f"--data {d}" for d in data)
+                             + f" --out {out} --epochs {epochs} --batch-size {batch_size} --seed {seed} --ema {ema:g} --select {select}"
                              + (f" --val {val}" if val else f" --val-fraction {val_fraction}")
                              + ("" if augment else " --no-augment")
                              + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")},

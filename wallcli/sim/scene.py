@@ -34,6 +34,7 @@ class SceneConfig:
     domain: str = "base"
     distance: tuple[float, float] = (1.0, 5.0)
     speed: tuple[float, float] = (0.5, 1.8)
+    roam: float = 2.5  # walkers stay within this many metres (along the wall) of the observed patch's centre
     codec: str | None = None  # ffv1 | libx264
     crf: int | None = None
     noise_scale: float = 1.0
@@ -184,10 +185,10 @@ def sample_scene(seed: int, config: SceneConfig | None = None, index: int | None
     n, acts = pick_people_activities(rng, config.people, config.activities)
     W, D, _ = room.size
     xc = (region[0] + region[1]) / 2
-    bounds = ((max(0.4, xc - 2.5), min(W - 0.4, xc + 2.5)),
+    bounds = ((max(0.4, xc - config.roam), min(W - 0.4, xc + config.roam)),
               (config.distance[0], max(config.distance[0] + 0.2, min(config.distance[1], D - 0.4))))
     # people who stay in one spot stand roughly in front of the observed patch (as in the seed's
-    # experiments); walkers roam +-2.5 m around it
+    # experiments); walkers roam +-config.roam around it
     half = (region[1] - region[0]) / 2 + 0.75
     spot_bounds = ((max(0.4, xc - half), min(W - 0.4, xc + half)), bounds[1])
     T = max(2, int(round(config.duration * cam.fps)))

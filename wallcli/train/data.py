@@ -23,12 +23,35 @@ SHARD_FORMAT = "wallcli.dataset-shard"
 
 
 class ShardDataset:
-    def __init__(self, root: Path | str, task: str, *, bins: int = 64, window: int = 256,
+    def __init__(self, root: Path | str | list, task: str, *, bins: int = 64, window: int = 256,
                  buffer_windows: int = 2048) -> None:
-        self.root = Path(root)
-        man_path = self.root / "dataset.json"
+        # several folders (e.g. two simulator runs with different seeds) act as one dataset
+        roots = [Path(r) for r in root] if isinstance(root, (list, tuple)) else [Path(root)]
+        if not roots:
+            raise WallcliError("no dataset folder given")
+        self.roots = roots
+        self.root = roots[0]
+        self.manifests = [self._manifest(r, task, bins, window) for r in roots]
+        self.manifest: dict[str, Any] = self.manifests[0]
+        self.task = task
+        self.inputs = TASK_INPUTS[task]
+        self.classes = TASK_CLASSES[task]
+        self.shape = (bins, window, 3)
+        self.files = [r / s["file"] for r, m in zip(roots, self.manifests) for s in m["shards"]]
+        self.sizes = np.array([int(s["n"]) for m in self.manifests for s in m["shards"]], dtype=np.int64)
+        self.offsets = np.concatenate([[0], np.cumsum(self.sizes)])
+        self.n = int(self.offsets[-1])
+        if self.n == 0:
+            raise WallcliError(f"{', '.join(map(str, roots))} holds no windows")
+        self.buffer_windows = max(int(buffer_windows), 1)
+        self._cache: OrderedDict[int, dict[str, np.ndarray]] = OrderedDict()
+        self._cache_windows = 0
+
+    @staticmethod
+    def _manifest(root: Path, task: str, bins: int, window: int) -> dict[str, Any]:
+        man_path = root / "dataset.json"
         if not man_path.is_file():
-            raise WallcliError(f"{self.root} is not a wallcli dataset (no dataset.json)",
+            raise WallcliError(f"{root} is not a wallcli dataset (no dataset.json)",
                                hint="create one with the simulator's dataset mode")
         try:
             man = json.loads(man_path.read_text(encoding="utf-8"))
@@ -37,29 +60,20 @@ class ShardDataset:
         if man.get("format") != DATASET_FORMAT or man.get("version") != 1:
             raise WallcliError(f"{man_path}: not a {DATASET_FORMAT} v1 manifest")
         if man.get("complete") is False:
-            raise WallcliError(f"{self.root} is still being written (dataset.json says complete: false)",
+            raise WallcliError(f"{root} is still being written (dataset.json says complete: false)",
                                hint="finish it by re-running the same dataset command")
         if man.get("task") != task:
-            raise WallcliError(f"{self.root} is a {man.get('task')!r} dataset, training a {task!r} model needs a {task!r} one")
+            raise WallcliError(f"{root} is a {man.get('task')!r} dataset, training a {task!r} model needs a {task!r} one")
         if list(man.get("classes", [])) != TASK_CLASSES[task]:
             raise WallcliError(f"{man_path}: classes {man.get('classes')} differ from {TASK_CLASSES[task]}")
         if man.get("window") != window or man.get("bins") != bins:
             raise WallcliError(f"{man_path}: windows are {man.get('bins')} bins x {man.get('window')} frames, "
                                f"the nets need {bins} x {window}")
-        self.manifest: dict[str, Any] = man
-        self.task = task
-        self.inputs = TASK_INPUTS[task]
-        self.classes = TASK_CLASSES[task]
-        self.shape = (bins, window, 3)
-        self.files = [self.root / s["file"] for s in man["shards"]]
-        self.sizes = np.array([int(s["n"]) for s in man["shards"]], dtype=np.int64)
-        self.offsets = np.concatenate([[0], np.cumsum(self.sizes)])
-        self.n = int(self.offsets[-1])
-        if self.n == 0:
-            raise WallcliError(f"{self.root} holds no windows")
-        self.buffer_windows = max(int(buffer_windows), 1)
-        self._cache: OrderedDict[int, dict[str, np.ndarray]] = OrderedDict()
-        self._cache_windows = 0
+        return man
+
+    @property
+    def recipes(self) -> list:
+        return [m.get("recipe") for m in self.manifests]
 
     # -- shards -----------------------------------------------------------------------
     def _load_shard(self, i: int) -> dict[str, np.ndarray]:
