@@ -31,3 +31,16 @@ def test_check_roi():
     assert check_roi(None, 64, 48) == (0, 0, 64, 48)
     with pytest.raises(WallcliError, match="64x48"):
         check_roi((60, 0, 10, 10), 64, 48)
+
+
+def test_projector_without_vertical_gives_the_same_horizontal_profile():
+    from wallcli.io.video import Planes
+    from wallcli.signal.blocks import RgbProjector
+
+    rng = np.random.default_rng(3)
+    planes = Planes(rng.integers(16, 236, (90, 160), dtype=np.uint8), rng.integers(16, 240, (45, 80), dtype=np.uint8),
+                    rng.integers(16, 240, (45, 80), dtype=np.uint8), sub_x=1, sub_y=1)
+    roi = (10.5, 7, 131, 70.25)
+    h_full, v_full = RgbProjector(roi, 16)(planes)
+    h_only, v_none = RgbProjector(roi, 16, vertical=False)(planes)
+    assert np.array_equal(h_full, h_only) and np.ptp(v_full) > 0 and not v_none.any()

@@ -102,7 +102,8 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     thumb = PlotThumbnail() if keep_plot else None
     times, probs, emitted = [], [], 0  # emitted: rows seen when the newest window was classified
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, progress=progress)
+        rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, progress=progress,
+                         vertical=keep_plot or "vertical" in model.input_names)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
@@ -167,7 +168,8 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> It
 
     windower = StreamWindower(model.window, stride)
     with open_video(source, threads=threads) as reader:
-        for t, row in RowStream(reader, roi=roi, bins=model.bins, fps=model.fps):
+        for t, row in RowStream(reader, roi=roi, bins=model.bins, fps=model.fps,
+                                vertical="vertical" in model.input_names):
             done = windower.push(t, row)
             if done is not None:
                 yield _window_record(model, done[0], _predict_window(model, done[2]))

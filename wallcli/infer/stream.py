@@ -18,12 +18,14 @@ class RowStream:
     Rows are the raw levels minus the first frame's (in float64, before storing float32): the
     offset is a constant per position and colour, which ``normalize_window`` removes with each
     window's mean anyway, and subtracting it keeps float32 precise for faint signals on bright walls.
-    ``roi`` and ``frame_size`` are known once the first frame is decoded.
+    ``roi`` and ``frame_size`` are known once the first frame is decoded. ``vertical=False``
+    leaves the vertical rows at zero without computing them (for models that do not read them).
     """
 
     def __init__(self, reader, *, roi=None, bins: int = 64, fps: float = 30.0,
-                 progress: Callable[[int], None] | None = None):
+                 progress: Callable[[int], None] | None = None, vertical: bool = True):
         self.reader, self.requested, self.bins, self.fps, self.progress = reader, roi, int(bins), fps, progress
+        self.vertical = vertical
         self.roi = None
         self.frame_size = None
         self.ref = None  # the first frame's raw row, subtracted from every row
@@ -41,7 +43,7 @@ class RowStream:
                 # streams), as in compute_stplot
                 self.frame_size = [frame.planes.width, frame.planes.height]
                 self.roi = check_roi(self.requested, *self.frame_size)
-                reduce = RowReducer(self.roi, self.bins)
+                reduce = RowReducer(self.roi, self.bins, self.vertical)
             row = np.concatenate(reduce(frame.planes))
             if self.ref is None:
                 self.ref = row

@@ -45,9 +45,9 @@ class StPlot:
 class RowReducer:
     """Per frame: the raw (not mean-removed) horizontal and vertical rows, float64 (bins, 3)."""
 
-    def __init__(self, roi: Roi, bins: int = 64):
+    def __init__(self, roi: Roi, bins: int = 64, vertical: bool = True):
         self.roi, self.bins = roi, int(bins)
-        self._project = RgbProjector(roi, self.bins)
+        self._project = RgbProjector(roi, self.bins, vertical)
 
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
         return self._project(planes)
