@@ -20,6 +20,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 NOISE_FLOOR = 0.35
+CLIP_GUARD = 235.0  # output code the brightest 0.5 % of the static wall may reach (headroom for AE steps)
 
 
 @dataclass
@@ -127,6 +128,17 @@ class Camera:
         img = self.gain_map * self.upsample(static_E).transpose(0, 2, 1)
         lin_level = 255.0 * (p.level / 255.0) ** p.gamma if p.gamma else p.level
         self.k = lin_level / img.mean()
+        # Exposure meters the wall's mean to `level` but never lets its brightest 0.5 % clip: a
+        # clipped wall carries neither signal nor noise (a bright lamp near the wall made 5-12 %
+        # of random scenes clip), and an operator or highlight-priority metering avoids it.
+        lin_cap = 255.0 * (CLIP_GUARD / 255.0) ** p.gamma if p.gamma else CLIP_GUARD
+        k_cap = lin_cap / max(float(np.percentile(img, 99.5)), 1e-12)
+        if k_cap < self.k:
+            self.k = k_cap
+            # the params describe the clip that was made (sidecar, SNR bookkeeping): record the
+            # mean level the capped exposure gives
+            lin_mean = self.k * float(img.mean())
+            p.level = 255.0 * (lin_mean / 255.0) ** (1.0 / p.gamma) if p.gamma else lin_mean
         # per-frame work runs in (H, 3, W) layout, the natural output of the separable upsampling
         chw = lambda a: np.ascontiguousarray(np.asarray(a, np.float32).transpose(0, 2, 1))  # noqa: E731
         self.static = chw(img * self.k)
