@@ -102,3 +102,30 @@ def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path):
     assert run_cli(["train", "count", "--data", str(tmp_path), "--out", str(tmp_path / "m.onnx")]) == 1
     err = capsys.readouterr().err
     assert err.startswith("Error:") and "pip install torch==2.13.0 && pip install 'wallcli[train]'" in err
+
+
+def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_dataset, tmp_path):
+    pytest.importorskip("onnx")
+    import onnx
+
+    data = make_dataset("activity", 16)
+    val = make_dataset("activity", 10, seed=4, shards=1, name="val")
+    out = tmp_path / "act.onnx"
+    args = ["train", "activity", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
+            "--batch-size", "8", "--threads", "2", "--quantize", "int8"]
+    assert run_cli(args) == 0
+    card = read_card(out)
+    assert card["sha256"] == sha256_file(out) and card["onnx"]["precision"] == "int8"
+    q = card["onnx"]["quantization"]
+    assert q["calibration_windows"] == 16 and "/Softmax" in q["float32_nodes"]
+    assert 0.0 <= q["max_probability_change"] < 0.5 and 0.0 <= q["float32_accuracy"] <= 1.0
+    assert card["validation"]["windows"] == 10 and "int8" in card["validation"]["measured_on"]
+    ops = {n.op_type for n in onnx.load(str(out)).graph.node}
+    assert "QuantizeLinear" in ops and "DequantizeLinear" in ops
+    # it runs through the normal inference path
+    from wallcli.infer.model import Model
+
+    m = Model.load(out, task="activity")
+    x = np.random.default_rng(0).standard_normal((2, 3, 64, 256)).astype(np.float32)
+    p = m.predict({"horizontal": x, "vertical": x})
+    assert p.shape == (2, 5) and np.allclose(p.sum(1), 1, atol=1e-5)

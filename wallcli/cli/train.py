@@ -42,6 +42,9 @@ def train(
     select: str = typer.Option("last", "--select", help="Export the weights after the last epoch ('last': the card's "
                                "validation accuracy is then a plain measurement) or of the epoch with the best "
                                "validation accuracy ('best')."),
+    quantize: str = typer.Option("none", "--quantize", help="none: ship the float32 graph; int8: ship a statically "
+                                 "quantised graph (about 1.6x faster on CPU; calibrated on 256 training windows, its "
+                                 "validation accuracy measured again and written in the card)."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
@@ -77,6 +80,8 @@ def train(
 
     if select not in ("last", "best"):
         raise UsageError(f"--select must be last or best (got {select!r})")
+    if quantize not in ("none", "int8"):
+        raise UsageError(f"--quantize must be none or int8 (got {quantize!r})")
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     check_outputs([out, card_path(out)], force=force)
@@ -114,12 +119,32 @@ def train(
                              + f" --out {out} --epochs {epochs} --batch-size {batch_size} --seed {seed} --ema {ema:g} --select {select}"
                              + (f" --val {val}" if val else f" --val-fraction {val_fraction}")
                              + ("" if augment else " --no-augment")
-                             + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")},
+                             + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")
+                             + (f" --quantize {quantize}" if quantize != "none" else "")},
         validation=validation,
     )
-    card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed)
+    quant = _quantize_data(result, seed) if quantize == "int8" else None
+    card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant)
     acc = f", validation accuracy {validation['accuracy']:.1%} on {validation['windows']} windows" if validation else ""
     log(f"wrote {out} and {card_path(out).name} (sha256 {card['sha256'][:12]}…){acc}")
+
+
+def _quantize_data(result, seed: int, calib_windows: int = 256) -> dict:
+    """Normalised calibration windows (from the training set) and the validation set, as feeds."""
+    import numpy as np
+
+    from wallcli.signal.window import normalize_window
+
+    ds, vds = result["dataset"], result["eval_dataset"]
+    rng = np.random.default_rng([seed, 0xC0A1])
+    tr = np.sort(rng.choice(result["train_indices"], min(calib_windows, len(result["train_indices"])), replace=False))
+    b = ds.gather(tr)
+    calib = {n: normalize_window(b[n]) for n in ds.inputs}
+    val = None
+    if len(result["val_indices"]):
+        vb = vds.gather(np.asarray(result["val_indices"]))
+        val = ({n: normalize_window(vb[n]) for n in ds.inputs}, vb["label"])
+    return {"calib": calib, "val": val}
 
 
 def _sigterm_interrupts() -> None:

@@ -61,10 +61,22 @@ def check_parity(net: torch.nn.Module, input_names: list[str], path: Path, *, se
     return worst
 
 
+def _requantified(validation: dict[str, Any] | None, probs: np.ndarray, labels: np.ndarray) -> dict[str, Any]:
+    """The validation record with accuracy, loss and confusion measured on the shipped (int8) graph."""
+    k = probs.shape[1]
+    cm = np.zeros((k, k), np.int64)
+    np.add.at(cm, (labels, probs.argmax(1)), 1)
+    loss = float(-np.mean(np.log(np.clip(probs[np.arange(len(labels)), labels], 1e-12, None))))
+    out = dict(validation or {})
+    out.update(windows=int(len(labels)), accuracy=float(np.trace(cm) / max(len(labels), 1)), loss=loss,
+               confusion_matrix=cm.tolist(), measured_on="the shipped int8 graph, through onnxruntime")
+    return out
+
+
 def build_card(*, name: str, version: str, task: str, classes: list[Any], input_names: list[str],
                sha256: str, size_bytes: int, parameters: int, stride: int = DEFAULT_STRIDE,
                training_data: dict[str, Any], training: dict[str, Any], validation: dict[str, Any] | None,
-               onnx_file: str, parity: float) -> dict[str, Any]:
+               onnx_file: str, parity: float, quantization: dict[str, Any] | None = None) -> dict[str, Any]:
     return {
         "format": CARD_FORMAT, "card_version": CARD_VERSION,
         "name": name, "version": version, "task": task, "classes": list(classes),
@@ -76,7 +88,8 @@ def build_card(*, name: str, version: str, task: str, classes: list[Any], input_
         "fps": int(CANONICAL_FPS) if float(CANONICAL_FPS).is_integer() else CANONICAL_FPS, "window": WINDOW, "bins": BINS, "stride": stride,
         "clip_aggregation": "mean of window probabilities",
         "onnx": {"file": onnx_file, "opset": OPSET, "bytes": size_bytes, "parameters": parameters,
-                 "parity_max_abs_diff": parity, "torch": torch.__version__},
+                 "parity_max_abs_diff": parity, "torch": torch.__version__,
+                 "precision": "int8" if quantization else "float32", "quantization": quantization},
         "sha256": sha256,
         "training_data": training_data,
         "training": training,
@@ -86,17 +99,41 @@ def build_card(*, name: str, version: str, task: str, classes: list[Any], input_
 
 
 def export_model(net: torch.nn.Module, input_names: list[str], out: Path, card_fields: dict[str, Any], *,
-                 force: bool = False, seed: int = 0) -> dict[str, Any]:
-    """Write OUT (.onnx) and its card OUT.json; returns the card."""
+                 force: bool = False, seed: int = 0, quantize: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Write OUT (.onnx) and its card OUT.json; returns the card.
+
+    ``quantize``: {"calib": feeds, "val": (feeds, labels) or None} ships an int8 graph instead
+    (wallcli/train/quantize.py); the float graph is still checked against torch first, and the
+    card's validation figures are measured again on the int8 graph.
+    """
+    import os
+
     from wallcli.io.writer import atomic_path
 
     out = Path(out)
     net = net.eval()
+    card_fields = dict(card_fields)
     with atomic_path(out, force=force) as tmp_onnx, atomic_path(card_path(out), force=force) as tmp_card:
         export_onnx(net, input_names, tmp_onnx)
         parity = check_parity(net, input_names, tmp_onnx, seed=seed)
+        quant = None
+        if quantize is not None:
+            from wallcli.train.quantize import onnx_probabilities, quantize_int8
+
+            fp32 = Path(str(tmp_onnx) + ".fp32.onnx")
+            os.replace(tmp_onnx, fp32)
+            try:
+                quant = quantize_int8(fp32, tmp_onnx, quantize["calib"])
+                if quantize.get("val") is not None:
+                    feeds, labels = quantize["val"]
+                    p32, p8 = onnx_probabilities(fp32, feeds), onnx_probabilities(tmp_onnx, feeds)
+                    quant["max_probability_change"] = float(np.abs(p8 - p32).max())
+                    quant["float32_accuracy"] = float(np.mean(p32.argmax(1) == labels))
+                    card_fields["validation"] = _requantified(card_fields.get("validation"), p8, labels)
+            finally:
+                fp32.unlink(missing_ok=True)
         card = build_card(input_names=input_names, sha256=sha256_file(tmp_onnx), size_bytes=tmp_onnx.stat().st_size,
                           parameters=sum(p.numel() for p in net.parameters()), onnx_file=out.name, parity=parity,
-                          **card_fields)
+                          quantization=quant, **card_fields)
         write_card(tmp_card, card)
     return card

@@ -230,4 +230,5 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
     net.eval()
     return {"net": net, "dataset": ds, "val_dataset": val_ds if cfg.val is not None else None,
             "validation": best["validation"], "best_epoch": best["epoch"], "history": history,
-            "train_windows": int(len(train_idx)), "val_windows": int(len(val_idx))}
+            "train_windows": int(len(train_idx)), "val_windows": int(len(val_idx)),
+            "train_indices": train_idx, "val_indices": val_idx, "eval_dataset": val_ds}
