@@ -52,3 +52,26 @@ def test_scene_plans_cover_every_class_and_mixed_pairs():
     act = [scene_plan(rng, "activity") for _ in range(300)]
     assert {lab for _, _, lab in act} == {0, 1, 2, 3, 4}
     assert {n for n, _, lab in act if lab == 0} == {0, 1}
+
+
+def test_window_snr_measures_the_signal_left_in_the_recorded_plot():
+    from types import SimpleNamespace
+
+    from wallcli.datagen.clips import WINDOW, _interp_matrix, _window_snr_db
+
+    rng = np.random.default_rng(0)
+    T, gx = 400, 32
+    t = np.arange(T) / 30.0
+    clean = (np.sin(2 * np.pi * 0.4 * t)[None, :, None] * np.linspace(0.5, 1.5, gx)[:, None, None]
+             * np.ones((1, 1, 3))) * 1e-3
+    scene = SimpleNamespace(clean_profiles=[(clean[:, i], None) for i in range(T)])
+    cam = SimpleNamespace(fps=30.0)
+    signal = 50.0 * np.einsum("bg,gtc->btc", _interp_matrix(64, gx), clean)  # gain 50 codes per unit change
+    noise = rng.standard_normal(signal.shape) * 0.02
+    starts = [0, T - WINDOW]
+    want = 10 * np.log10(np.mean((signal - signal.mean(1, keepdims=True))[:, :WINDOW] ** 2) / 0.02**2)
+    got = _window_snr_db(scene, cam, (signal + noise).astype(np.float32), t, starts)
+    assert np.allclose(got, want, atol=0.3)
+    # a codec that erased the signal (frames repeated: no change at all) leaves nothing visible
+    flat = np.zeros_like(signal) + rng.standard_normal(signal.shape) * 1e-4
+    assert (_window_snr_db(scene, cam, flat.astype(np.float32), t, starts) < -20).all()
