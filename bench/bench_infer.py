@@ -8,6 +8,8 @@
   time (30 fps) through a pipe; latency = time the JSON line is read minus the time the
   window's last frame was written.  Includes pipe, decoding, plot rows, resampling and the net.
 - --clip: decode-only frames/s with PyAV vs ``wallcli count CLIP --json`` frames/s (target >= 0.6x).
+- --int8: also times an int8 copy of each float32 model (``wallcli train --quantize int8``'s
+  quantisation, calibrated here on random windows: a speed figure only, not an accuracy one).
 
 Without --model-dir the shipped models are used; when those are missing and torch is
 installed, randomly initialised nets are exported to a temporary folder (speed does not
@@ -55,6 +57,24 @@ def model_paths(model_dir: str | None) -> dict[str, Path]:
     return paths
 
 
+def int8_copies(paths: dict[str, Path]) -> dict[str, Path]:
+    """Quantised copies of the float32 models in a temporary folder (skips models already int8)."""
+    from wallcli.infer.card import read_card
+    from wallcli.train.quantize import quantize_int8
+
+    tmp = Path(tempfile.mkdtemp(prefix="wallcli-int8-"))
+    rng = np.random.default_rng(1)
+    out = {}
+    for task, path in paths.items():
+        card = read_card(path)
+        if card.get("onnx", {}).get("precision") == "int8":
+            continue
+        calib = {i["name"]: rng.standard_normal((32, 3, 64, 256)).astype(np.float32) for i in card["inputs"]}
+        quantize_int8(path, tmp / f"{task}.onnx", calib)
+        out[f"{task} int8"] = tmp / f"{task}.onnx"
+    return out
+
+
 def bench_windows(paths: dict[str, Path], threads: int, repeat: int) -> None:
     from wallcli.infer.model import Model
     from wallcli.signal.window import normalize_window
@@ -66,6 +86,24 @@ def bench_windows(paths: dict[str, Path], threads: int, repeat: int) -> None:
         normalize_window(raw)
     print(f"normalize_window: {(time.perf_counter() - t0) / repeat / 32 * 1000:.3f} ms per window")
     for task, path in paths.items():
+        if task.endswith(" int8"):  # a bare session: the copy has no card of its own
+            import onnxruntime as ort
+
+            opts = ort.SessionOptions()
+            if threads > 0:
+                opts.intra_op_num_threads = threads
+            sess = ort.InferenceSession(str(path), opts, providers=["CPUExecutionProvider"])
+            names = [i.name for i in sess.get_inputs()]
+            for batch in (1, 32):
+                feed = {n: normalize_window(raw[:batch]) for n in names}
+                sess.run(None, feed)
+                n = max(repeat * (32 // batch) // 4, 5)
+                t0 = time.perf_counter()
+                for _ in range(n):
+                    sess.run(None, feed)
+                dt = (time.perf_counter() - t0) / n / batch * 1000
+                print(f"{task:13s} threads={threads} batch={batch:2d}: {dt:.2f} ms per window")
+            continue
         m = Model.load(path, task=task, threads=threads)
         for batch in (1, 32):
             x = normalize_window(raw[:batch])
@@ -156,9 +194,10 @@ def main() -> None:
     ap.add_argument("--follow", action="store_true")
     ap.add_argument("--follow-seconds", type=float, default=20.0)
     ap.add_argument("--clip")
+    ap.add_argument("--int8", action="store_true", help="also time int8 copies of float32 models")
     a = ap.parse_args()
     paths = model_paths(a.model_dir)
-    bench_windows(paths, a.threads, a.repeat)
+    bench_windows({**paths, **(int8_copies(paths) if a.int8 else {})}, a.threads, a.repeat)
     if a.follow:
         bench_follow(paths, a.threads, a.follow_seconds)
     if a.clip:
