@@ -62,16 +62,27 @@ def test_window_snr_measures_the_signal_left_in_the_recorded_plot():
     rng = np.random.default_rng(0)
     T, gx = 400, 32
     t = np.arange(T) / 30.0
-    clean = (np.sin(2 * np.pi * 0.4 * t)[None, :, None] * np.linspace(0.5, 1.5, gx)[:, None, None]
-             * np.ones((1, 1, 3))) * 1e-3
-    scene = SimpleNamespace(clean_profiles=[(clean[:, i], None) for i in range(T)])
+    ramp = np.linspace(0.5, 1.5, gx)[:, None, None] * np.ones((1, 1, 3))
+    a = np.sin(2 * np.pi * 0.4 * t)[None, :, None] * ramp * 1e-3  # person A
+    b = np.cos(2 * np.pi * 0.13 * t)[None, :, None] * ramp[::-1] * 1e-5  # person B: 40 dB fainter
     cam = SimpleNamespace(fps=30.0)
-    signal = 50.0 * np.einsum("bg,gtc->btc", _interp_matrix(64, gx), clean)  # gain 50 codes per unit change
-    noise = rng.standard_normal(signal.shape) * 0.02
+    up = _interp_matrix(64, gx)
     starts = [0, T - WINDOW]
-    want = 10 * np.log10(np.mean((signal - signal.mean(1, keepdims=True))[:, :WINDOW] ** 2) / 0.02**2)
-    got = _window_snr_db(scene, cam, (signal + noise).astype(np.float32), t, starts)
-    assert np.allclose(got, want, atol=0.3)
+
+    def record(clean, sigma):
+        sig = 50.0 * np.einsum("bg,gtc->btc", up, clean)  # gain 50 codes per unit change
+        return (sig + rng.standard_normal(sig.shape) * sigma).astype(np.float32), sig
+
+    one = SimpleNamespace(clean_profiles=[(a[:, i], None) for i in range(T)])
+    h, sig = record(a, 0.02)
+    want = 10 * np.log10(np.mean((sig - sig.mean(1, keepdims=True))[:, :WINDOW] ** 2) / 0.02**2)
+    both, weakest = _window_snr_db(one, cam, h, t, starts)
+    assert np.allclose(both, want, atol=0.3) and np.allclose(weakest, both)
     # a codec that erased the signal (frames repeated: no change at all) leaves nothing visible
-    flat = np.zeros_like(signal) + rng.standard_normal(signal.shape) * 1e-4
-    assert (_window_snr_db(scene, cam, flat.astype(np.float32), t, starts) < -20).all()
+    flat = (rng.standard_normal(h.shape) * 1e-4).astype(np.float32)
+    assert (_window_snr_db(one, cam, flat, t, starts)[0] < -20).all()
+    # two people, one of them far under the noise: together visible, the weakest is not
+    two = SimpleNamespace(clean_profiles=[((a + b)[:, i], None, [a[:, i], b[:, i]]) for i in range(T)])
+    h2, _ = record(a + b, 0.02)
+    both, weakest = _window_snr_db(two, cam, h2, t, starts)
+    assert (both > 3).all() and (weakest < -20).all()

@@ -53,43 +53,58 @@ def _window_starts(length: int, k: int, rng) -> list[int]:
     return sorted(int(v) for v in np.clip(np.rint(base + jitter), 0, span))
 
 
-def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) -> np.ndarray:
+def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """Per window: how visible the people are in the plot that was actually recorded, in dB.
 
     The renderer's noise-free relative irradiance change, averaged over wall rows and resampled
-    like the plot, is fitted to the window by least squares (one gain, since exposure, tone curve
-    and vignetting scale it): SNR = power of the fitted signal / power of what is left (noise,
-    camera nuisances, compression artefacts). A signal that the codec erased (H.264 skips
+    like the plot, is fitted to the window by least squares (one gain per person, since exposure,
+    tone curve and vignetting scale it): SNR = power of the fitted signal / power of what is left
+    (noise, camera nuisances, compression artefacts). A signal that the codec erased (H.264 skips
     blocks that barely change) or that drowns in noise scores low, whatever the scene's physics
-    promised. NaN where nobody moves (or in flatland). Lets training and evaluation stratify
-    windows by visibility.
+    promised. Returns (all movers together, the least visible mover alone); NaN where nobody
+    moves (or in flatland). Lets training and evaluation stratify windows by visibility.
     """
     from wallcli.signal.window import resample
 
-    out = np.full(len(starts), np.nan, np.float32)
+    both = np.full(len(starts), np.nan, np.float32)
+    weakest = np.full(len(starts), np.nan, np.float32)
     profiles = getattr(scene, "clean_profiles", None)
     if not profiles:
-        return out
-    clean = np.stack([p[0] for p in profiles], axis=1)  # (gx, T, 3) relative change per wall column
-    clean, _ = resample(clean, np.arange(clean.shape[1]) / cam.fps, FPS)
-    gx, bins = clean.shape[0], h.shape[0]
-    # wall grid columns and plot bins both span the observed region evenly
-    w = _interp_matrix(bins, gx)
+        return both, weakest
+
+    def prep(seq):  # (gx, T, 3) per wall column -> (bins, T', 3) at the plot's rate and bins
+        c = np.stack(seq, axis=1)
+        c, _ = resample(c, np.arange(c.shape[1]) / cam.fps, FPS)
+        return np.einsum("bg,gtc->btc", _interp_matrix(h.shape[0], c.shape[0]), c)
+
+    clean = prep([p[0] for p in profiles])
+    if not np.any(clean):  # nobody in the scene
+        return both, weakest
+    people = [prep([p[2][j] for p in profiles]) for j in range(len(profiles[0][2]))] if len(profiles[0]) > 2 else [clean]
     for k, s in enumerate(starts):
-        c = np.einsum("bg,gtc->btc", w, clean[:, s : s + WINDOW]).astype(np.float64)
         x = h[:, s : s + WINDOW].astype(np.float64)
-        if c.shape[1] < WINDOW or x.shape[1] < WINDOW:
+        if x.shape[1] < WINDOW or clean.shape[1] < s + WINDOW:
             continue
-        c -= c.mean(axis=1, keepdims=True)
-        x -= x.mean(axis=1, keepdims=True)
-        cc = float(np.sum(c * c))
-        if cc <= 0:
-            continue
-        beta = float(np.sum(x * c)) / cc
-        sig = beta * beta * cc
-        rest = float(np.sum((x - beta * c) ** 2))
-        out[k] = 10.0 * np.log10(max(sig, 1e-30) / max(rest, 1e-30))
-    return out
+        x = (x - x.mean(axis=1, keepdims=True)).ravel()
+        each, total = _fit_snr_db(x, [c[:, s : s + WINDOW] for c in people])
+        both[k], weakest[k] = total, each.min()
+    return both, weakest
+
+
+def _fit_snr_db(x: np.ndarray, signals: list[np.ndarray]) -> tuple[np.ndarray, float]:
+    """Least-squares fit of x by the (mean-removed) signals, one gain each: (each one's fitted
+    power over the residual's, all of them together over the residual's), in dB."""
+    A = np.stack([(c - c.mean(axis=1, keepdims=True)).astype(np.float64).ravel() for c in signals], axis=1)
+    norms = np.sum(A * A, axis=0)
+    ok = norms > 0
+    out = np.full(len(signals), -np.inf)
+    if not ok.any():
+        return out, -np.inf
+    beta, *_ = np.linalg.lstsq(A[:, ok], x, rcond=None)
+    fit = A[:, ok] @ beta
+    rest = max(float(np.sum((x - fit) ** 2)), 1e-30)
+    out[ok] = 10.0 * np.log10(np.maximum(beta**2 * norms[ok], 1e-30) / rest)
+    return out, float(10.0 * np.log10(max(float(np.sum(fit * fit)), 1e-30) / rest))
 
 
 def _interp_matrix(n_out: int, n_in: int) -> np.ndarray:
@@ -146,7 +161,7 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
     h, t = resample(plot.horizontal, plot.time, FPS)
     v, _ = resample(plot.vertical, plot.time, FPS)
     starts = _window_starts(h.shape[1], windows, rng)
-    snr = _window_snr_db(scene, cam, h, t, starts)
+    snr, snr_weakest = _window_snr_db(scene, cam, h, t, starts)
     truth = scene.truth()
     meta = {k: truth[k] for k in ("people", "activity", "activities", "fps", "frames", "width", "height", "domain")}
     meta.update(seed=int(seed), index=int(index), world=world, camera=truth["camera"],
@@ -159,5 +174,6 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         "people": np.full(len(starts), len(acts), np.int64),
         "activity": np.full(len(starts), activity, np.int64),
         "snr_db": snr,
+        "snr_db_weakest": snr_weakest,
         "scenes": [dict(meta, window_start_s=round(s / FPS, 3)) for s in starts],
     }

@@ -56,8 +56,9 @@ class Scene:
     times: np.ndarray
     rng: np.random.Generator
     # Set to [] before frames() to collect, per frame, the noise-free relative irradiance change
-    # averaged over wall rows and columns: ((gx, 3), (gy, 3)). Dataset mode uses it to measure
-    # how visible the people are in each window.
+    # averaged over wall rows and columns: ((gx, 3), (gy, 3)), plus, with several people, a list
+    # of each person's own (gx, 3) change. Dataset mode uses it to measure how visible the people
+    # are in each window.
     clean_profiles: list | None = None
 
     @property
@@ -103,8 +104,20 @@ class Scene:
             else:
                 dE = np.zeros_like(E0)
             if self.clean_profiles is not None:
-                rel = dE / np.maximum(E0, 1e-12)
-                self.clean_profiles.append((rel.mean(axis=0), rel.mean(axis=1)))
+                E0_safe = np.maximum(E0, 1e-12)
+                rel = dE / E0_safe
+                entry = (rel.mean(axis=0), rel.mean(axis=1))
+                if len(tracks) > 1:
+                    # each person alone as well (one more physics pass): a window where one of two
+                    # people is invisible must not pass for a window where both are seen
+                    alone = []
+                    for c, r, a in tracks:
+                        Ci = c[i]
+                        dEi = body_delta(self.room, self.points, Ci, r, body_radiance(self.room, Ci, a, view), bbox,
+                                         overlapping_pairs(probes, Ci, r))
+                        alone.append((dEi / E0_safe).mean(axis=0))
+                    entry = (*entry, alone)
+                self.clean_profiles.append(entry)
             yield cam.render(dE, i, static_E=E0)
 
     def truth(self, frames: int | None = None) -> dict:

@@ -134,9 +134,11 @@ class ShardDataset:
         for i, f in enumerate(self.files):
             try:
                 with np.load(f, allow_pickle=False) as npz:
-                    if "snr_db" not in npz.files:
+                    # the least visible mover when recorded (two people: both must be seen)
+                    key = "snr_db_weakest" if "snr_db_weakest" in npz.files else "snr_db"
+                    if key not in npz.files:
                         raise WallcliError(f"{f} has no per-window snr_db; regenerate it to filter by visibility")
-                    snr[self.offsets[i]:self.offsets[i + 1]] = npz["snr_db"]
+                    snr[self.offsets[i]:self.offsets[i + 1]] = npz[key]
             except (OSError, ValueError, zipfile.BadZipFile) as e:
                 raise WallcliError(f"{f} is not a readable shard ({e})") from None
         s = snr[indices]
