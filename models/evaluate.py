@@ -10,7 +10,6 @@ where it stops being able to see.
 from __future__ import annotations
 
 import argparse
-import json
 
 import numpy as np
 
@@ -24,15 +23,12 @@ SNR_EDGES = [-np.inf, -20.0, -10.0, 0.0, 10.0, np.inf]
 def evaluate(task: str, data: str, model_path: str | None = None, visible_db: float = -10.0) -> dict:
     model = load_model(task, model_path)
     ds = ShardDataset(data, task)
-    probs, labels, snr = [], [], []
-    for i, f in enumerate(ds.files):
+    probs, labels = [], []
+    for i in range(len(ds.files)):
         arrays = ds._load_shard(i)
-        with np.load(f, allow_pickle=False) as npz:
-            key = "snr_db_weakest" if "snr_db_weakest" in npz.files else "snr_db"  # the least visible mover
-            snr.append(npz[key] if key in npz.files else np.full(len(arrays["label"]), np.nan))
         probs.append(model.predict({name: normalize_window(arrays[name]) for name in ds.inputs}))
         labels.append(arrays["label"])
-    p, y, s = np.concatenate(probs), np.concatenate(labels), np.concatenate(snr)
+    p, y, s = np.concatenate(probs), np.concatenate(labels), ds.visibility()
     pred = p.argmax(axis=1)
     k = len(model.classes)
     cm = np.zeros((k, k), np.int64)

@@ -57,7 +57,8 @@ def test_scene_plans_cover_every_class_and_mixed_pairs():
 def test_window_snr_measures_the_signal_left_in_the_recorded_plot():
     from types import SimpleNamespace
 
-    from wallcli.datagen.clips import WINDOW, _interp_matrix, _window_snr_db
+    from wallcli.datagen.clips import WINDOW, _window_snr_db
+    from wallcli.sim.camera import interp_matrix
 
     rng = np.random.default_rng(0)
     T, gx = 400, 32
@@ -66,7 +67,7 @@ def test_window_snr_measures_the_signal_left_in_the_recorded_plot():
     a = np.sin(2 * np.pi * 0.4 * t)[None, :, None] * ramp * 1e-3  # person A
     b = np.cos(2 * np.pi * 0.13 * t)[None, :, None] * ramp[::-1] * 1e-5  # person B: 40 dB fainter
     cam = SimpleNamespace(fps=30.0)
-    up = _interp_matrix(64, gx)
+    up = interp_matrix(64, gx)
     starts = [0, T - WINDOW]
 
     def record(clean, sigma):

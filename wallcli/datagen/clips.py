@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wallcli.sim.camera import video_pix_fmt
+from wallcli.sim.camera import interp_matrix, video_pix_fmt
 from wallcli.sim.motion import ACTIVITIES
 from wallcli.sim.scene import SceneConfig, sample_scene
 from wallcli.sim.world_flat import sample_flat_scene
@@ -75,7 +75,7 @@ def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) 
     def prep(seq):  # (gx, T, 3) per wall column -> (bins, T', 3) at the plot's rate and bins
         c = np.stack(seq, axis=1)
         c, _ = resample(c, np.arange(c.shape[1]) / cam.fps, FPS)
-        return np.einsum("bg,gtc->btc", _interp_matrix(h.shape[0], c.shape[0]), c)
+        return np.einsum("bg,gtc->btc", interp_matrix(h.shape[0], c.shape[0]), c)
 
     clean = prep([p[0] for p in profiles])
     if not np.any(clean):  # nobody in the scene
@@ -105,17 +105,6 @@ def _fit_snr_db(x: np.ndarray, signals: list[np.ndarray]) -> tuple[np.ndarray, f
     rest = max(float(np.sum((x - fit) ** 2)), 1e-30)
     out[ok] = 10.0 * np.log10(np.maximum(beta**2 * norms[ok], 1e-30) / rest)
     return out, float(10.0 * np.log10(max(float(np.sum(fit * fit)), 1e-30) / rest))
-
-
-def _interp_matrix(n_out: int, n_in: int) -> np.ndarray:
-    """(n_out, n_in) linear interpolation from n_in samples at the edges of [0, 1] to n_out bin centres."""
-    pos = ((np.arange(n_out) + 0.5) / n_out) * (n_in - 1)
-    k = np.minimum(pos.astype(int), n_in - 2)
-    w = pos - k
-    A = np.zeros((n_out, n_in))
-    A[np.arange(n_out), k] = 1 - w
-    A[np.arange(n_out), k + 1] = w
-    return A
 
 
 def render_windows(seed: int, index: int, task: str, *, domain: str = "base", world: str = "room",

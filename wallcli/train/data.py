@@ -30,7 +30,6 @@ class ShardDataset:
         if not roots:
             raise WallcliError("no dataset folder given")
         self.roots = roots
-        self.root = roots[0]
         self.manifests = [self._manifest(r, task, bins, window) for r in roots]
         self.manifest: dict[str, Any] = self.manifests[0]
         self.task = task
@@ -119,6 +118,25 @@ class ShardDataset:
                 out[name][sel] = arrs[name][local]
         return out
 
+    def visibility(self) -> np.ndarray:
+        """Per window, the least visible mover's SNR in the recorded plot, dB (NaN: nobody moving).
+
+        Shards from before per-person visibility hold only ``snr_db`` (all movers together).
+        """
+        import zipfile
+
+        snr = np.full(self.n, np.nan, np.float32)
+        for i, f in enumerate(self.files):
+            try:
+                with np.load(f, allow_pickle=False) as npz:
+                    key = "snr_db_weakest" if "snr_db_weakest" in npz.files else "snr_db"
+                    if key not in npz.files:
+                        raise WallcliError(f"{f} has no per-window snr_db; regenerate it to filter by visibility")
+                    snr[self.offsets[i]:self.offsets[i + 1]] = npz[key]
+            except (OSError, ValueError, zipfile.BadZipFile) as e:
+                raise WallcliError(f"{f} is not a readable shard ({e})") from None
+        return snr
+
     def visible(self, indices: np.ndarray, min_snr_db: float | None) -> np.ndarray:
         """``indices`` without windows whose movers are too faint to see (snr_db < min_snr_db).
 
@@ -128,20 +146,7 @@ class ShardDataset:
         indices = np.asarray(indices, dtype=np.int64)
         if min_snr_db is None:
             return indices
-        import zipfile
-
-        snr = np.full(self.n, np.nan, np.float32)
-        for i, f in enumerate(self.files):
-            try:
-                with np.load(f, allow_pickle=False) as npz:
-                    # the least visible mover when recorded (two people: both must be seen)
-                    key = "snr_db_weakest" if "snr_db_weakest" in npz.files else "snr_db"
-                    if key not in npz.files:
-                        raise WallcliError(f"{f} has no per-window snr_db; regenerate it to filter by visibility")
-                    snr[self.offsets[i]:self.offsets[i + 1]] = npz[key]
-            except (OSError, ValueError, zipfile.BadZipFile) as e:
-                raise WallcliError(f"{f} is not a readable shard ({e})") from None
-        s = snr[indices]
+        s = self.visibility()[indices]
         return indices[np.isnan(s) | (s >= min_snr_db)]
 
     # -- epochs -----------------------------------------------------------------------
