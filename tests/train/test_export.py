@@ -90,11 +90,19 @@ def test_train_on_two_folders(make_dataset, tmp_path):
     b = make_dataset("count", 8, seed=5, shards=1, name="more")
     out = tmp_path / "count.onnx"
     args = ["train", "count", "--data", str(a), "--data", str(b), "--val-fraction", "0.25", "--out", str(out),
-            "--epochs", "1", "--batch-size", "4", "--threads", "1", "--ema", "0"]
+            "--epochs", "1", "--batch-size", "4", "--threads", "1", "--ema", "0", "--superpose", "0.5"]
     assert run_cli(args) == 0
     card = read_card(out)
     assert card["training_data"]["windows"] == 20 and len(card["training_data"]["recipe"]) == 2
     assert card["training_data"]["dataset"] == [str(a), str(b)]
+    assert card["training"]["augmentation"][0].startswith("superposition") and "--superpose 0.5" in card["training"]["command"]
+
+
+def test_superpose_is_refused_for_activity(make_dataset, tmp_path, capsys):
+    data = make_dataset("activity", 8)
+    args = ["train", "activity", "--data", str(data), "--out", str(tmp_path / "a.onnx"), "--superpose", "0.3"]
+    assert run_cli(args) == 2
+    assert "count only" in capsys.readouterr().err
 
 
 def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path):

@@ -106,3 +106,27 @@ def test_checkpoints_within_an_epoch_on_a_timer(make_dataset, tmp_path):
     mid = [f["batch"] for k, f in events if k == "checkpoint" and f["epoch"] == 0]
     assert mid == [1, 2, 3]  # after every step (21 training windows -> 3 batches of 8, 8, 5)
     assert ("checkpoint", {"path": tmp_path / "m.ckpt.pt", "epoch": 1, "batch": 0}) in events  # epoch end
+
+
+def test_superpose_adds_windows_and_their_counts():
+    from wallcli.train.augment import superpose
+
+    rng = np.random.default_rng(0)
+    b = {"horizontal": rng.normal(size=(40, 64, 256, 3)).astype(np.float32), "label": np.array([0, 1, 2, 1] * 10)}
+    out = superpose(b, ["horizontal"], np.random.default_rng(3), p=0.5)
+    again = superpose(b, ["horizontal"], np.random.default_rng(3), p=0.5)
+    assert np.array_equal(out["horizontal"], again["horizontal"]) and np.array_equal(out["label"], again["label"])
+    assert out["label"].max() <= 2 and np.all(out["label"] >= b["label"])
+    changed = np.flatnonzero(np.any(out["horizontal"] != b["horizontal"], axis=(1, 2, 3)))
+    assert 8 <= len(changed) <= 32  # about half, each partnered
+    for i in changed:
+        rest = out["horizontal"][i] - b["horizontal"][i]  # the scaled partner, possibly flipped/reversed
+        cands = [j for j in range(40) if j != i and b["label"][i] + b["label"][j] == out["label"][i]]
+        views = [b["horizontal"][j][::fs, ::ft] for j in cands for fs in (1, -1) for ft in (1, -1)]
+        corr = max(abs(np.corrcoef(rest.ravel(), v.ravel())[0, 1]) for v in views)
+        assert corr > 0.999
+        ratio = np.std(rest) / np.std(b["horizontal"][i])
+        assert 0.45 < ratio < 2.2
+    # two-person windows take no partner but an empty one; nothing exceeds two people
+    assert np.all(out["label"][b["label"] == 2] == 2)
+    assert np.array_equal(superpose(b, ["horizontal"], np.random.default_rng(3), p=0.0)["label"], b["label"])

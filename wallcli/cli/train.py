@@ -45,6 +45,9 @@ def train(
     quantize: str = typer.Option("none", "--quantize", help="none: ship the float32 graph; int8: ship a statically "
                                  "quantised graph (about 1.6x faster on CPU; calibrated on 256 training windows, its "
                                  "validation accuracy measured again and written in the card)."),
+    superpose: float = typer.Option(0.0, "--superpose", min=0.0, max=1.0, help="count only: share of training windows "
+                                    "replaced by their sum with another window of the batch, labels added (light "
+                                    "transport is linear; see wallcli/train/augment.py). 0: off."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
@@ -74,7 +77,7 @@ def train(
     from wallcli.errors import UsageError
     from wallcli.infer.card import card_path
     from wallcli.io.writer import check_outputs
-    from wallcli.train.augment import DESCRIPTION
+    from wallcli.train.augment import DESCRIPTION, SUPERPOSE_DESCRIPTION
     from wallcli.train.export import export_model
     from wallcli.train.loop import TrainConfig, train as run_training
 
@@ -82,13 +85,15 @@ def train(
         raise UsageError(f"--select must be last or best (got {select!r})")
     if quantize not in ("none", "int8"):
         raise UsageError(f"--quantize must be none or int8 (got {quantize!r})")
+    if superpose > 0 and task.value != "count":
+        raise UsageError("--superpose applies to count only (people add up; activities do not)")
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     check_outputs([out, card_path(out)], force=force)
     cfg = TrainConfig(task=task.value, data=list(data), out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
-                      min_snr_db=min_snr_db, ema=ema, select=select)
+                      min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose)
 
     _sigterm_interrupts()
     with _TrainProgress(console_err) as bar:
@@ -112,13 +117,15 @@ def train(
         training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
         training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
-                  "loss": "cross-entropy", "augmentation": DESCRIPTION if augment else [],
+                  "loss": "cross-entropy", "augmentation": ([SUPERPOSE_DESCRIPTION.format(p=superpose)] if superpose > 0 else [])
+                  + (DESCRIPTION if augment else []),
                   "weight_average": {"ema_decay_per_step": ema, "exported": select},
                   "selected_epoch": result["best_epoch"], "history": result["history"],
                   "command": f"wallcli train {task.value} " + " ".join(f"--data {d}" for d in data)
                              + f" --out {out} --epochs {epochs} --batch-size {batch_size} --seed {seed} --ema {ema:g} --select {select}"
                              + (f" --val {val}" if val else f" --val-fraction {val_fraction}")
                              + ("" if augment else " --no-augment")
+                             + (f" --superpose {superpose:g}" if superpose > 0 else "")
                              + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")
                              + (f" --quantize {quantize}" if quantize != "none" else "")},
         validation=validation,

@@ -16,7 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from wallcli.datagen.clips import BINS, FPS, WINDOW, render_windows
+from wallcli.datagen.clips import BINS, COUNT_ACTS, FPS, WINDOW, render_windows
 from wallcli.sim.motion import ACTIVITIES
 
 FORMAT, VERSION = "wallcli.dataset", 1
@@ -26,9 +26,12 @@ ARRAYS = ("horizontal", "vertical", "label", "people", "activity", "snr_db", "sn
 
 
 def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible") -> dict:
-    return {"task": task, "seed": int(seed), "windows": int(n), "domain": domain, "world": world,
+    rec = {"task": task, "seed": int(seed), "windows": int(n), "domain": domain, "world": world,
             "windows_per_scene": int(windows_per_scene), "shard_scenes": int(shard_scenes), "grid": list(grid),
             "placement": placement, "generator": "wallcli.datagen v1"}
+    if task == "count":  # the movers' activity mix (a dataset made with another mix is another dataset)
+        rec["count_activities"] = dict(zip(*COUNT_ACTS))
+    return rec
 
 
 def _shards(n: int, wps: int, per: int) -> list[tuple[int, list[int], int]]:

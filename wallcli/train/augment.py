@@ -16,6 +16,19 @@ its label, which is how a model trained on the simulator learns to ignore the ro
   darker rooms, stronger compression.
 - slow illumination drift (p 0.3): a ramp common to all positions (daylight, auto exposure),
   up to half the window's RMS.
+
+Count only, optional (``--superpose P``, off by default):
+
+- superposition: a window becomes itself plus another window of the batch (labels add, never
+  above 2 people). Light transport is linear, and a person changes the wall's light by well under
+  1 %, so two people's changes add; the sum of a one-person window from one room and a
+  one-person window from another is what two people look like to the plot, noise included
+  (each part brings its own, so a sum's noise level says nothing about its label: 0 + 0, 0 + 1
+  and 0 + 2 sums exist too). The partner is scaled so its RMS is 0.5-2x the window's (log-
+  uniform): neither part drowns the other, as both movers of a training window are visible.
+  It multiplies the two-person configurations the net sees at no simulation cost; real
+  two-person scenes still teach what one room with two people looks like.
+
 Augmentations draw from a generator seeded by (seed, epoch, batch), so resumed runs repeat them.
 """
 from __future__ import annotations
@@ -30,6 +43,49 @@ DESCRIPTION = [
     "added white noise, std log-uniform 2-50% of window RMS (p=0.5)",
     "slow illumination ramp common to all positions, up to 0.5x window RMS (p=0.3)",
 ]
+
+
+SUPERPOSE_DESCRIPTION = ("superposition with another window of the batch (count: labels add, at most 2), "
+                         "partner scaled to 0.5-2x the window's RMS, log-uniform (p={p:g})")
+
+
+def _rms(x: np.ndarray) -> float:
+    c = x - x.mean(axis=1, keepdims=True)  # per bin and channel over time: the plot's variation
+    return float(np.sqrt(np.mean(c.astype(np.float64) ** 2))) + 1e-12
+
+
+def superpose(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Generator, p: float,
+              max_label: int = 2) -> dict[str, np.ndarray]:
+    """Replace a fraction ``p`` of windows by their sum with a partner of the batch (count labels add).
+
+    Partners come from the unmodified batch and keep label sums <= ``max_label``; a partner is
+    mirrored in space (horizontal plot) and reversed in time independently, half the time each.
+    """
+    y = np.asarray(batch["label"])
+    out = dict(batch)
+    if p <= 0 or len(y) < 2:
+        return out
+    arrays = {n: batch[n].astype(np.float32, copy=True) for n in inputs}
+    labels = y.copy()
+    for i in np.flatnonzero(rng.random(len(y)) < p):
+        ok = np.flatnonzero((y + y[i] <= max_label) & (np.arange(len(y)) != i))
+        if not len(ok):
+            continue
+        j = int(rng.choice(ok))
+        ratio = float(np.exp(rng.uniform(np.log(0.5), np.log(2.0))))
+        flip, rev = rng.random() < 0.5, rng.random() < 0.5
+        scale = ratio * _rms(batch[inputs[0]][i]) / _rms(batch[inputs[0]][j])
+        for n in inputs:
+            part = batch[n][j].astype(np.float32)
+            if flip and n == "horizontal":
+                part = part[::-1]
+            if rev:
+                part = part[:, ::-1]
+            arrays[n][i] += np.float32(scale) * part
+        labels[i] = y[i] + y[j]
+    out.update(arrays)
+    out["label"] = labels
+    return out
 
 
 def augment(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Generator) -> dict[str, np.ndarray]:

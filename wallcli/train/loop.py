@@ -30,7 +30,7 @@ import torch
 from torch import nn
 
 from wallcli.errors import WallcliError
-from wallcli.train.augment import augment
+from wallcli.train.augment import augment, superpose
 from wallcli.train.data import ShardDataset, split_validation
 from wallcli.train.nets import build
 
@@ -60,6 +60,7 @@ class TrainConfig:
     min_snr_db: float | None = None  # drop training windows whose movers are fainter than this
     ema: float = 0.995  # per-step decay of the weight average (0: no averaging)
     select: str = "last"  # export the last epoch's weights, or the "best" on validation
+    superpose: float = 0.0  # count: fraction of windows summed with another (augment.superpose)
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
@@ -116,7 +117,7 @@ def _save_checkpoint(path: Path, state: dict[str, Any]) -> None:
 def _identity(cfg: TrainConfig, ds: ShardDataset) -> dict[str, Any]:
     # what must match for a checkpoint to be resumable into this run
     return {"task": cfg.task, "windows": ds.n, "dataset_seed": [m.get("seed") for m in ds.manifests], "ema": cfg.ema,
-            "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None}
+            "superpose": cfg.superpose, "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None}
 
 
 def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
@@ -181,6 +182,8 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         try:
             for bi in range(start_batch, len(batches)):
                 b = ds.gather(batches[bi])
+                if cfg.superpose > 0:
+                    b = superpose(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0x5AB]), cfg.superpose)
                 if cfg.augment:
                     b = augment(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0xA06]))
                 xs = [_to_tensor(b[n], cfg.channels_last) for n in ds.inputs]
