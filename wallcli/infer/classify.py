@@ -98,7 +98,6 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.io.video import open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
 
-    model.warm_up()  # onnxruntime loads while the first window's frames decode
     windower = StreamWindower(model.window, stride)
     thumb = PlotThumbnail() if keep_plot else None
     times, probs, emitted = [], [], 0  # emitted: rows seen when the newest window was classified
@@ -167,7 +166,6 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> It
     from wallcli.io.video import open_video
     from wallcli.infer.stream import RowStream
 
-    model.warm_up()
     windower = StreamWindower(model.window, stride)
     with open_video(source, threads=threads) as reader:
         for t, row in RowStream(reader, roi=roi, bins=model.bins, fps=model.fps,

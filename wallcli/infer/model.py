@@ -6,7 +6,6 @@ the model that was checked (no window between the check and the load).
 """
 from __future__ import annotations
 
-import threading
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -40,9 +39,6 @@ class Model:
         self._data = data
         self.threads = threads
         self._session = None
-        self._lock = threading.Lock()
-        self._warming: threading.Thread | None = None
-        self._warm_error: BaseException | None = None
 
     @classmethod
     def load(cls, path: Path | str, *, task: str | None = None, threads: int = 0) -> "Model":
@@ -89,34 +85,8 @@ class Model:
         return {"name": self.card["name"], "version": self.card["version"], "sha256": self.card["sha256"]}
 
     # -- session ----------------------------------------------------------------------
-    def warm_up(self) -> None:
-        """Build the session in a background thread (importing onnxruntime and loading the graph
-        take ~0.3 s), overlapped with the decoding that starts meanwhile; the first ``predict``
-        waits for it. A failure is raised there, in the caller's thread."""
-        if self._session is not None or self._warming is not None:
-            return
-
-        def build():
-            try:
-                self.session  # noqa: B018 (builds and caches it)
-            except BaseException as e:  # handed to the first predict
-                self._warm_error = e
-
-        self._warming = threading.Thread(target=build, name="wallcli-model-load", daemon=True)
-        self._warming.start()
-
     @property
     def session(self):
-        if self._warming is not None and self._warming is not threading.current_thread():
-            self._warming.join()
-            self._warming = None
-            if self._warm_error is not None:
-                err, self._warm_error = self._warm_error, None
-                raise err
-        with self._lock:
-            return self._build_session()
-
-    def _build_session(self):
         if self._session is None:
             import onnxruntime as ort
 
