@@ -3,21 +3,21 @@
 # validation sets (other seeds, moved room/people/camera ranges), train, export ONNX + cards.
 #   bash models/train.sh
 # Steps resume: rerunning skips finished shards and continues training from checkpoints.
-# Time on 2 CPU cores: ~15 min per 2560 windows of simulation, ~3 min (count) / ~7 min
-# (activity) per training epoch.
+# Time on 2 CPU cores: ~15 min per 2560 windows of simulation (count4: ~57 min), ~7 min per
+# count epoch (6560 windows kept of 8192), ~4 min per activity epoch (1994 of 3072).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 W=${WALLCLI:-.venv/bin/wallcli}
 JOBS=${JOBS:-2}
-EPOCHS_COUNT=${EPOCHS_COUNT:-9}
+EPOCHS_COUNT=${EPOCHS_COUNT:-8}
 EPOCHS_ACTIVITY=${EPOCHS_ACTIVITY:-12}
 
 # people placed where their light reaches the camera above its noise (--placement visible, the default)
-# count 0.2.0, as shipped
-$W simulate --dataset 512 --task count -o data/val_count3 --jobs "$JOBS" --seed 105 --domain shifted
-$W simulate --dataset 2560 --task count -o data/count3 --jobs "$JOBS" --seed 5 --world mixed
-$W train count --data data/count3 --val data/val_count3 --out models/count.onnx --epochs "$EPOCHS_COUNT" \
-  --threads 2 --min-snr-db -10 --select last --model-version 0.2.0 --force
+# count 0.3.0, as shipped: moving people only, a quarter flatland, superposition augmentation
+$W simulate --dataset 512 --task count -o data/val_count4 --jobs "$JOBS" --seed 106 --domain shifted
+$W simulate --dataset 8192 --task count -o data/count4 --jobs "$JOBS" --seed 6 --world mixed
+$W train count --data data/count4 --val data/val_count4 --out models/count.onnx --epochs "$EPOCHS_COUNT" \
+  --threads 2 --min-snr-db -10 --select last --superpose 0.25 --quantize int8 --model-version 0.3.0 --force
 
 # activity 0.2.0, as shipped
 $W simulate --dataset 384 --task activity -o data/val_activity2 --jobs "$JOBS" --seed 104 --domain shifted
