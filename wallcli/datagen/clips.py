@@ -19,15 +19,15 @@ from wallcli.sim.scene import SceneConfig, sample_scene
 from wallcli.sim.world_flat import sample_flat_scene
 
 WINDOW, FPS, BINS = 256, 30.0, 64
-# Class mixes. Count: the task counts people who *move*; someone standing still sways a centimetre,
-# far under any camera's noise, so a standing person in a count scene would be label noise. Count
-# scenes hold movers only, each drawing an activity independently (walking most often: it is the
-# commonest way to be in a room and the hardest to tell one from two).
 # Where dataset people go. 'visible': 0.8-4 m from the wall and walking within 1.5 m of the observed
 # patch, where their light change stands above a camera's noise (the seed's experiments put people
 # 1.75-3.95 m away); 'anywhere': 1-5 m, roaming 2.5 m, as `simulate` videos do (many such windows
 # carry no detectable signal, which only teaches a model to guess).
 PLACEMENTS = {"visible": {"distance": (0.8, 4.0), "roam": 1.5}, "anywhere": {"distance": (1.0, 5.0), "roam": 2.5}}
+# Class mixes. Count: the task counts people who *move*; someone standing still sways a centimetre,
+# far under any camera's noise, so a standing person in a count scene would be label noise. Count
+# scenes hold movers only, each drawing an activity independently (walking most often: it is the
+# commonest way to be in a room and the hardest to tell one from two).
 COUNT_ACTS = (["walking", "crouching", "waving", "jumping"], [0.46, 0.18, 0.18, 0.18])
 
 
