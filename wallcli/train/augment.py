@@ -49,9 +49,11 @@ SUPERPOSE_DESCRIPTION = ("superposition with another window of the batch (count:
                          "partner scaled to 0.5-2x the window's RMS, log-uniform (p={p:g})")
 
 
-def _rms(x: np.ndarray) -> float:
-    c = x - x.mean(axis=1, keepdims=True)  # per bin and channel over time: the plot's variation
-    return float(np.sqrt(np.mean(c.astype(np.float64) ** 2))) + 1e-12
+def window_rms(x: np.ndarray) -> np.ndarray:
+    """RMS of each window's own variation (B, bins, T, C) -> (B,): the per-bin mean over time is
+    removed first, as it is irrelevant after normalisation."""
+    centred = x - x.mean(axis=2, keepdims=True)
+    return np.sqrt((centred.astype(np.float64) ** 2).mean(axis=(1, 2, 3))) + 1e-12
 
 
 def superpose(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Generator, p: float,
@@ -67,6 +69,7 @@ def superpose(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Ge
         return out
     arrays = {n: batch[n].astype(np.float32, copy=True) for n in inputs}
     labels = y.copy()
+    rms = window_rms(batch[inputs[0]])
     for i in np.flatnonzero(rng.random(len(y)) < p):
         ok = np.flatnonzero((y + y[i] <= max_label) & (np.arange(len(y)) != i))
         if not len(ok):
@@ -74,7 +77,7 @@ def superpose(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Ge
         j = int(rng.choice(ok))
         ratio = float(np.exp(rng.uniform(np.log(0.5), np.log(2.0))))
         flip, rev = rng.random() < 0.5, rng.random() < 0.5
-        scale = ratio * _rms(batch[inputs[0]][i]) / _rms(batch[inputs[0]][j])
+        scale = ratio * rms[i] / rms[j]
         for n in inputs:
             part = batch[n][j].astype(np.float32)
             if flip and n == "horizontal":
@@ -110,9 +113,7 @@ def augment(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Gene
         x[reverse] = x[reverse, :, ::-1]
         x = np.take_along_axis(x, perms[:, None, None, :], axis=3)
         x *= gains
-        # scale of the window's own variation (the per-bin mean is irrelevant after normalisation)
-        centred = x - x.mean(axis=2, keepdims=True)
-        rms = np.sqrt((centred.astype(np.float64) ** 2).mean(axis=(1, 2, 3))) + 1e-12
+        rms = window_rms(x)
         x += (rng.standard_normal(x.shape, dtype=np.float32)
               * (noise_rel * rms).astype(np.float32)[:, None, None, None])
         x += (drift_rel * rms).astype(np.float32)[:, None, None, None] * ramp[None, None, :, None]
