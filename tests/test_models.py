@@ -1,6 +1,6 @@
 """The shipped models: golden outputs on a seeded clip through the whole run-time path.
 
-(The v0.1 models do not yet give the true answers on examples/: see models/README.md.)"""
+(How they fare on the bundled examples: tests/test_examples.py.)"""
 
 import json
 from pathlib import Path
