@@ -9,15 +9,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 W=${WALLCLI:-.venv/bin/wallcli}
 JOBS=${JOBS:-2}
-EPOCHS_COUNT=${EPOCHS_COUNT:-8}
+EPOCHS_COUNT=${EPOCHS_COUNT:-12}
 EPOCHS_ACTIVITY=${EPOCHS_ACTIVITY:-12}
 
 # people placed where their light reaches the camera above its noise (--placement visible, the default)
-# count 0.3.0, as shipped: moving people only, a quarter flatland, superposition augmentation
+# count 0.4.0, as shipped: moving people only, a quarter flatland, superposition augmentation
 $W simulate --dataset 512 --task count -o data/val_count4 --jobs "$JOBS" --seed 106 --domain shifted
 $W simulate --dataset 8192 --task count -o data/count4 --jobs "$JOBS" --seed 6 --world mixed
 $W train count --data data/count4 --val data/val_count4 --out models/count.onnx --epochs "$EPOCHS_COUNT" \
-  --threads 2 --min-snr-db -10 --select last --superpose 0.25 --quantize int8 --model-version 0.3.0 --force
+  --threads 2 --min-snr-db -10 --select last --superpose 0.25 --quantize int8 --model-version 0.4.0 --force
 
 # activity 0.2.0, as shipped
 $W simulate --dataset 384 --task activity -o data/val_activity2 --jobs "$JOBS" --seed 104 --domain shifted

@@ -112,7 +112,7 @@ def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path):
     assert err.startswith("Error:") and "pip install torch==2.13.0 && pip install 'wallcli[train]'" in err
 
 
-def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_dataset, tmp_path):
+def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_dataset, tmp_path, capsys):
     pytest.importorskip("onnx")
     import onnx
 
@@ -124,6 +124,9 @@ def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_datas
     assert run_cli(args) == 0
     card = read_card(out)
     assert card["sha256"] == sha256_file(out) and card["onnx"]["precision"] == "int8"
+    # the closing line reports the shipped (int8) graph's accuracy, the one in the card
+    err = " ".join(capsys.readouterr().err.split())  # rich may wrap the line
+    assert err.endswith(f"validation accuracy {card['validation']['accuracy']:.1%} on 10 windows")
     q = card["onnx"]["quantization"]
     assert q["calibration_windows"] == 16 and "/Softmax" in q["float32_nodes"]
     assert 0.0 <= q["max_probability_change"] < 0.5 and 0.0 <= q["float32_accuracy"] <= 1.0

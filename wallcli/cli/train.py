@@ -132,7 +132,8 @@ def train(
     )
     quant = _quantize_data(result, seed) if quantize == "int8" else None
     card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant)
-    acc = f", validation accuracy {validation['accuracy']:.1%} on {validation['windows']} windows" if validation else ""
+    shipped = card.get("validation") or {}  # with --quantize, the int8 graph's figure (what ships)
+    acc = f", validation accuracy {shipped['accuracy']:.1%} on {shipped['windows']} windows" if shipped else ""
     log(f"wrote {out} and {card_path(out).name} (sha256 {card['sha256'][:12]}…){acc}")
 
 
