@@ -21,8 +21,6 @@ CLIPS = sorted(EXAMPLES.glob("*.mp4"))
 KNOWN_WRONG = {
     ("count", "standing"): "count 0.4.0 says 1 (the person does not move)",
     ("count", "two-mixed"): "count 0.4.0 says 1",
-    ("activity", "standing"): "activity 0.2.0 says walking",
-    ("activity", "waving"): "activity 0.2.0 says jumping",
 }
 
 
