@@ -3,8 +3,8 @@
 # validation sets (other seeds, moved room/people/camera ranges), train, export ONNX + cards.
 #   bash models/train.sh
 # Steps resume: rerunning skips finished shards and continues training from checkpoints.
-# Time on 2 CPU cores: ~15 min per 2560 windows of simulation (count4: ~57 min), ~7 min per
-# count epoch (6560 windows kept of 8192), ~14 min per activity epoch (7104 of 11264 windows kept; activity3 alone: ~60 min of simulation).
+# Time on 2 CPU cores: ~15 min per 2560 windows of simulation (count4 or activity3: ~60 min),
+# ~7 min per count epoch (6560 windows kept of 8192), ~14 min per activity epoch (7104 kept of 11264).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 W=${WALLCLI:-.venv/bin/wallcli}
