@@ -26,7 +26,9 @@ def _windows(labels: np.ndarray, rng: np.random.Generator, bins: int = 64, t: in
     return x
 
 
-def write_dataset(root: Path, task: str, n: int, *, seed: int = 0, shards: int = 2) -> Path:
+def write_dataset(root: Path, task: str, n: int, *, seed: int = 0, shards: int = 2, visibility: bool = False) -> Path:
+    """n windows; with ``visibility``, as the simulator writes them: two windows per scene, each
+    with its movers' SNR (NaN where nobody moves)."""
     root.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
     classes = TASK_CLASSES[task]
@@ -37,9 +39,13 @@ def write_dataset(root: Path, task: str, n: int, *, seed: int = 0, shards: int =
         lab = labels[part]
         arrays = {"horizontal": _windows(lab, rng), "vertical": _windows(lab, rng), "label": lab.astype(np.int64),
                   "people": np.minimum(lab, 2).astype(np.int64), "activity": lab.astype(np.int64)}
+        scenes = [{"k": int(k)} for k in lab]
+        if visibility:
+            snr = np.where(lab > 0, rng.uniform(-25.0, 15.0, len(lab)), np.nan).astype(np.float32)
+            arrays.update(snr_db=snr, snr_db_weakest=snr)
+            scenes = [dict(sc, seed=seed, index=int(i) // 2) for sc, i in zip(scenes, part)]
         name = f"shard-{s:05d}.npz"
-        save_npz(root / name, arrays, {"format": "wallcli.dataset-shard", "task": task, "seed": seed,
-                                       "scenes": [{"k": int(k)} for k in lab]})
+        save_npz(root / name, arrays, {"format": "wallcli.dataset-shard", "task": task, "seed": seed, "scenes": scenes})
         entries.append({"file": name, "n": int(len(lab))})
     (root / "dataset.json").write_text(json.dumps({
         "format": "wallcli.dataset", "version": 1, "task": task, "classes": classes, "fps": 30, "window": 256,
@@ -49,6 +55,7 @@ def write_dataset(root: Path, task: str, n: int, *, seed: int = 0, shards: int =
 
 @pytest.fixture
 def make_dataset(tmp_path):
-    def make(task: str = "count", n: int = 64, *, seed: int = 0, shards: int = 2, name: str = "data") -> Path:
-        return write_dataset(tmp_path / name, task, n, seed=seed, shards=shards)
+    def make(task: str = "count", n: int = 64, *, seed: int = 0, shards: int = 2, name: str = "data",
+             visibility: bool = False) -> Path:
+        return write_dataset(tmp_path / name, task, n, seed=seed, shards=shards, visibility=visibility)
     return make

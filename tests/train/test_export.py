@@ -61,7 +61,7 @@ def test_parity_check_detects_a_different_model(tmp_path):
 
 def test_train_command_end_to_end(make_dataset, tmp_path, capsys):
     data = make_dataset("count", 20)
-    val = make_dataset("count", 6, seed=9, shards=1, name="val")
+    val = make_dataset("count", 6, seed=9, shards=1, name="val", visibility=True)
     out = tmp_path / "models" / "count.onnx"
     out.parent.mkdir()
     args = ["train", "count", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
@@ -76,6 +76,12 @@ def test_train_command_end_to_end(make_dataset, tmp_path, capsys):
     v = card["validation"]
     assert v["windows"] == 6 and np.array(v["confusion_matrix"]).shape == (3, 3)
     assert np.array(v["confusion_matrix"]).sum() == 6 and 0.0 <= v["accuracy"] <= 1.0
+    # measured on the exported graph, with the scene-bootstrap interval and visible-window figures
+    assert v["measured_on"].startswith("the shipped float32 graph") and v["scenes"] == 3
+    lo, hi = v["accuracy_95ci"]
+    assert 0.0 <= lo <= v["accuracy"] <= hi <= 1.0
+    labels = np.concatenate([np.load(f)["label"] for f in sorted(val.glob("shard-*.npz"))])
+    assert v["visible"]["windows"] >= int((labels == 0).sum()) and v["accuracy_by_snr"]
     assert card["training"]["weight_average"] == {"ema_decay_per_step": 0.995, "exported": "last"}
     assert card["validation"]["epoch"] == 1
     assert out.with_suffix(".ckpt.pt").is_file()

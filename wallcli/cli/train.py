@@ -130,29 +130,45 @@ def train(
                              + (f" --quantize {quantize}" if quantize != "none" else "")},
         validation=validation,
     )
-    quant = _quantize_data(result, seed) if quantize == "int8" else None
-    card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant)
+    quant = _calibration(result, seed) if quantize == "int8" else None
+    card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant,
+                        evaluation=_evaluation(result))
     shipped = card.get("validation") or {}  # with --quantize, the int8 graph's figure (what ships)
     acc = f", validation accuracy {shipped['accuracy']:.1%} on {shipped['windows']} windows" if shipped else ""
     log(f"wrote {out} and {card_path(out).name} (sha256 {card['sha256'][:12]}…){acc}")
 
 
-def _quantize_data(result, seed: int, calib_windows: int = 256) -> dict:
-    """Normalised calibration windows (from the training set) and the validation set, as feeds."""
+def _calibration(result, seed: int, calib_windows: int = 256) -> dict:
+    """Normalised calibration windows for int8 quantisation, drawn from the training set."""
     import numpy as np
 
     from wallcli.signal.window import normalize_window
 
-    ds, vds = result["dataset"], result["eval_dataset"]
+    ds = result["dataset"]
     rng = np.random.default_rng([seed, 0xC0A1])
     tr = np.sort(rng.choice(result["train_indices"], min(calib_windows, len(result["train_indices"])), replace=False))
     b = ds.gather(tr)
-    calib = {n: normalize_window(b[n]) for n in ds.inputs}
-    val = None
-    if len(result["val_indices"]):
-        vb = vds.gather(np.asarray(result["val_indices"]))
-        val = ({n: normalize_window(vb[n]) for n in ds.inputs}, vb["label"])
-    return {"calib": calib, "val": val}
+    return {"calib": {n: normalize_window(b[n]) for n in ds.inputs}}
+
+
+def _evaluation(result) -> dict | None:
+    """The validation windows as the exported graph sees them, with each one's visibility and scene."""
+    import numpy as np
+
+    from wallcli.signal.window import normalize_window
+
+    vds, idx = result["eval_dataset"], np.asarray(result["val_indices"])
+    if not len(idx):
+        return None
+    from wallcli.errors import WallcliError
+
+    vb = vds.gather(idx)
+    try:
+        visibility = vds.visibility()[idx]
+    except WallcliError:  # a dataset that does not record its movers' SNR: no visible-window figures
+        visibility = None
+    return {"feeds": {n: normalize_window(vb[n]) for n in vds.inputs}, "labels": vb["label"],
+            "visibility": visibility, "scenes": vds.scene_ids()[idx]}
 
 
 def _sigterm_interrupts() -> None:

@@ -137,6 +137,27 @@ class ShardDataset:
                 raise WallcliError(f"{f} is not a readable shard ({e})") from None
         return snr
 
+    def scene_ids(self) -> np.ndarray:
+        """Per window, an integer naming the simulated scene (seed, index) it was cut from; a window
+        without a scene record counts as a scene of its own."""
+        import json
+        import zipfile
+
+        keys: dict = {}
+        ids = np.zeros(self.n, np.int64)
+        for i, f in enumerate(self.files):
+            try:
+                with np.load(f, allow_pickle=False) as npz:
+                    scenes = json.loads(str(npz["meta"][()]))["scenes"]
+            except (OSError, ValueError, KeyError, TypeError, zipfile.BadZipFile) as e:
+                raise WallcliError(f"{f} has no readable scene list ({e})") from None
+            if len(scenes) != self.sizes[i]:
+                raise WallcliError(f"{f}: {len(scenes)} scene records for {self.sizes[i]} windows")
+            ids[self.offsets[i]:self.offsets[i + 1]] = [
+                keys.setdefault((s.get("seed"), s.get("index")) if "index" in s else ("window", self.offsets[i] + j), len(keys))
+                for j, s in enumerate(scenes)]
+        return ids
+
     def visible(self, indices: np.ndarray, min_snr_db: float | None) -> np.ndarray:
         """``indices`` without windows whose movers are too faint to see (snr_db < min_snr_db).
 

@@ -61,15 +61,17 @@ def check_parity(net: torch.nn.Module, input_names: list[str], path: Path, *, se
     return worst
 
 
-def _requantified(validation: dict[str, Any] | None, probs: np.ndarray, labels: np.ndarray) -> dict[str, Any]:
-    """The validation record with accuracy, loss and confusion measured on the shipped (int8) graph."""
-    k = probs.shape[1]
-    cm = np.zeros((k, k), np.int64)
-    np.add.at(cm, (labels, probs.argmax(1)), 1)
+def _measured(validation: dict[str, Any] | None, probs: np.ndarray, evaluation: dict[str, Any],
+              measured_on: str) -> dict[str, Any]:
+    """The validation record measured again on the graph that ships, through onnxruntime: accuracy
+    with its scene-bootstrap interval, loss, confusion, visible-window and per-SNR figures."""
+    from wallcli.train.metrics import breakdown
+
+    labels = np.asarray(evaluation["labels"], np.int64)
     loss = float(-np.mean(np.log(np.clip(probs[np.arange(len(labels)), labels], 1e-12, None))))
     out = dict(validation or {})
-    out.update(windows=int(len(labels)), accuracy=float(np.trace(cm) / max(len(labels), 1)), loss=loss,
-               confusion_matrix=cm.tolist(), measured_on="the shipped int8 graph, through onnxruntime")
+    out.update(breakdown(probs, labels, evaluation["visibility"], evaluation["scenes"]))
+    out.update(loss=loss, measured_on=measured_on)
     return out
 
 
@@ -99,12 +101,14 @@ def build_card(*, name: str, version: str, task: str, classes: list[Any], input_
 
 
 def export_model(net: torch.nn.Module, input_names: list[str], out: Path, card_fields: dict[str, Any], *,
-                 force: bool = False, seed: int = 0, quantize: dict[str, Any] | None = None) -> dict[str, Any]:
+                 force: bool = False, seed: int = 0, quantize: dict[str, Any] | None = None,
+                 evaluation: dict[str, Any] | None = None) -> dict[str, Any]:
     """Write OUT (.onnx) and its card OUT.json; returns the card.
 
-    ``quantize``: {"calib": feeds, "val": (feeds, labels) or None} ships an int8 graph instead
-    (wallcli/train/quantize.py); the float graph is still checked against torch first, and the
-    card's validation figures are measured again on the int8 graph.
+    ``quantize``: {"calib": feeds} ships an int8 graph instead (wallcli/train/quantize.py); the
+    float graph is still checked against torch first.
+    ``evaluation``: {"feeds", "labels", "visibility", "scenes"} of the validation windows: the
+    card's validation figures are then measured on the exported graph, through onnxruntime.
     """
     import os
 
@@ -124,14 +128,20 @@ def export_model(net: torch.nn.Module, input_names: list[str], out: Path, card_f
             os.replace(tmp_onnx, fp32)
             try:
                 quant = quantize_int8(fp32, tmp_onnx, quantize["calib"])
-                if quantize.get("val") is not None:
-                    feeds, labels = quantize["val"]
-                    p32, p8 = onnx_probabilities(fp32, feeds), onnx_probabilities(tmp_onnx, feeds)
-                    quant["max_probability_change"] = float(np.abs(p8 - p32).max())
-                    quant["float32_accuracy"] = float(np.mean(p32.argmax(1) == labels))
-                    card_fields["validation"] = _requantified(card_fields.get("validation"), p8, labels)
+                if evaluation is not None:
+                    p32 = onnx_probabilities(fp32, evaluation["feeds"])
+                    quant["float32_accuracy"] = float(np.mean(p32.argmax(1) == evaluation["labels"]))
             finally:
                 fp32.unlink(missing_ok=True)
+        if evaluation is not None:
+            from wallcli.train.quantize import onnx_probabilities
+
+            shipped = onnx_probabilities(tmp_onnx, evaluation["feeds"])
+            if quant is not None:
+                quant["max_probability_change"] = float(np.abs(shipped - p32).max())
+            card_fields["validation"] = _measured(
+                card_fields.get("validation"), shipped, evaluation,
+                f"the shipped {'int8' if quant is not None else 'float32'} graph, through onnxruntime")
         card = build_card(input_names=input_names, sha256=sha256_file(tmp_onnx), size_bytes=tmp_onnx.stat().st_size,
                           parameters=sum(p.numel() for p in net.parameters()), onnx_file=out.name, parity=parity,
                           quantization=quant, **card_fields)
