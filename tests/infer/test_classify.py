@@ -137,3 +137,15 @@ def test_follow_refuses_plot_and_npz(models, plot_file, run_cli, tmp_path):
     assert code == 2 and "--follow" in err
     code, _, err = run_cli("count", plot_file(), "--follow", "--model", models["count"])
     assert code == 2
+
+
+def test_accuracy_note_reads_the_cards_validation():
+    from wallcli.cli._classify import accuracy_note
+
+    card = {"name": "m", "version": "1.0", "validation": {
+        "accuracy": 0.643, "accuracy_95ci": [0.568, 0.717],
+        "visible": {"min_snr_db": -10.0, "accuracy": 0.881, "accuracy_95ci": [0.827, 0.93]}}}
+    note = accuracy_note(card)
+    assert note.startswith("m 1.0: right on 88% (95 % CI 83%-93%)") and "64% (95 % CI 57%-72%) of all" in note
+    assert accuracy_note({"validation": {"accuracy": 0.9}}) is None  # no visible-window figure: no note
+    assert accuracy_note({"validation": None}) is None

@@ -78,3 +78,28 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     print_table(f"{input}: {task} = {result['label']} (p={max(result['probabilities']):.2f}; "
                 f"{len(result['windows'])} windows of {span:.2f} s)",
                 ["start (s)", "label", *(f"{c} people" if isinstance(c, int) else str(c) for c in classes)], rows)
+    note = accuracy_note(model.card)
+    if note:
+        from wallcli.cli.output import log
+
+        log(note)
+
+
+def accuracy_note(card: dict) -> str | None:
+    """One line saying how far the model's answers can be trusted, from its card's validation.
+
+    Printed under the table (to stderr, for the reader, not for scripts): a probability of 0.9
+    from a model that is right on 64 % of windows is not a 90 % answer.
+    """
+    v = card.get("validation") or {}
+    vis = v.get("visible") or {}
+    if not isinstance(v.get("accuracy"), (int, float)) or not isinstance(vis.get("accuracy"), (int, float)):
+        return None
+
+    def ci(block):
+        iv = block.get("accuracy_95ci")
+        return f" (95 % CI {iv[0]:.0%}-{iv[1]:.0%})" if isinstance(iv, list) and len(iv) == 2 else ""
+
+    return (f"{card.get('name', 'model')} {card.get('version', '')}: right on {vis['accuracy']:.0%}{ci(vis)} of "
+            f"validation windows where the people are visible (>= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
+            f"{ci(v)} of all; a faint or distant mover reads as nobody. See the model card.")
