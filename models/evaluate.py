@@ -15,7 +15,6 @@ import argparse
 import numpy as np
 
 from wallcli.infer.model import load_model
-from wallcli.signal.window import normalize_window
 from wallcli.train.data import ShardDataset
 from wallcli.train.metrics import VISIBLE_DB, breakdown
 
@@ -26,7 +25,7 @@ def evaluate(task: str, data: str, model_path: str | None = None, visible_db: fl
     probs, labels = [], []
     for i in range(len(ds.files)):
         arrays = ds._load_shard(i)
-        probs.append(model.predict({name: normalize_window(arrays[name]) for name in ds.inputs}))
+        probs.append(model.predict({name: model.normalize(arrays[name]) for name in ds.inputs}))
         labels.append(arrays["label"])
     r = breakdown(np.concatenate(probs), np.concatenate(labels), ds.visibility(), ds.scene_ids(), visible_db)
     return {"task": task, "data": data, "model": model.info(), "classes": model.classes, **r}

@@ -146,3 +146,29 @@ def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_datas
     x = np.random.default_rng(0).standard_normal((2, 3, 64, 256)).astype(np.float32)
     p = m.predict({"horizontal": x, "vertical": x})
     assert p.shape == (2, 5) and np.allclose(p.sum(1), 1, atol=1e-5)
+
+
+def test_preprocessing_v2_is_trained_recorded_and_followed_at_inference(make_dataset, tmp_path, capsys):
+    from wallcli.infer.model import Model
+    from wallcli.signal.window import NORMALIZATION_V2, normalize_window
+
+    data = make_dataset("count", 12)
+    val = make_dataset("count", 6, seed=9, shards=1, name="val", visibility=True)
+    out = tmp_path / "count.onnx"
+    args = ["train", "count", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
+            "--batch-size", "4", "--threads", "1", "--preprocessing", "v2"]
+    assert run_cli(args) == 0
+    card = read_card(out)
+    assert card["preprocessing"] == NORMALIZATION_V2 and "asinh" in card["normalisation"]
+    assert "--preprocessing v2" in card["training"]["command"]
+    m = Model.load(out)
+    x = np.random.default_rng(0).normal(size=(2, 64, 256, 3)).astype(np.float32)
+    assert np.array_equal(m.normalize(x), normalize_window(x, NORMALIZATION_V2))
+    # the card's validation was measured with v2 inputs: scoring them again gives its figure
+    labels = np.concatenate([np.load(f)["label"] for f in sorted(val.glob("shard-*.npz"))])
+    raw = np.concatenate([np.load(f)["horizontal"] for f in sorted(val.glob("shard-*.npz"))])
+    assert np.mean(m.predict({"horizontal": m.normalize(raw)}).argmax(1) == labels) == card["validation"]["accuracy"]
+    # a v1 checkpoint is not resumed into a v2 run (the inputs differ), and unknown versions are refused
+    assert run_cli([*args[:-2], "--preprocessing", "v1", "--force"]) == 1
+    assert "different run" in capsys.readouterr().err
+    assert run_cli([*args[:-2], "--preprocessing", "v3", "--force"]) == 2

@@ -48,6 +48,10 @@ def train(
     superpose: float = typer.Option(0.0, "--superpose", min=0.0, max=1.0, help="count only: share of training windows "
                                     "replaced by their sum with another window of the batch, labels added (light "
                                     "transport is linear; see wallcli/train/augment.py). 0: off."),
+    preprocessing: str = typer.Option("v1", "--preprocessing", help="Window normalisation the net learns on, recorded "
+                                      "in the card (inference follows the card): v1 = divided by the window's RMS; v2 = "
+                                      "in units of the window's frame-to-frame noise, asinh-compressed, so a faint "
+                                      "second mover is not scaled away by a strong first (wallcli/signal/window.py)."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
@@ -87,13 +91,19 @@ def train(
         raise UsageError(f"--quantize must be none or int8 (got {quantize!r})")
     if superpose > 0 and task.value != "count":
         raise UsageError("--superpose applies to count only (people add up; activities do not)")
+    from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2
+
+    versions = {"v1": NORMALIZATION, "v2": NORMALIZATION_V2}
+    if preprocessing not in versions:
+        raise UsageError(f"--preprocessing must be v1 or v2 (got {preprocessing!r})")
+    prep = versions[preprocessing]
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     check_outputs([out, card_path(out)], force=force)
     cfg = TrainConfig(task=task.value, data=list(data), out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
-                      min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose)
+                      min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep)
 
     _sigterm_interrupts()
     with _TrainProgress(console_err) as bar:
@@ -114,6 +124,7 @@ def train(
         }
     fields = dict(
         name=name or f"wallcli-{task.value}", version=model_version, task=task.value, classes=ds.classes, stride=stride,
+        preprocessing=prep, normalisation=NORMALIZATION_TEXT[prep],
         training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
         training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
@@ -127,18 +138,19 @@ def train(
                              + ("" if augment else " --no-augment")
                              + (f" --superpose {superpose:g}" if superpose > 0 else "")
                              + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")
-                             + (f" --quantize {quantize}" if quantize != "none" else "")},
+                             + (f" --quantize {quantize}" if quantize != "none" else "")
+                             + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")},
         validation=validation,
     )
-    quant = _calibration(result, seed) if quantize == "int8" else None
+    quant = _calibration(result, seed, prep) if quantize == "int8" else None
     card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant,
-                        evaluation=_evaluation(result))
+                        evaluation=_evaluation(result, prep))
     shipped = card.get("validation") or {}  # with --quantize, the int8 graph's figure (what ships)
     acc = f", validation accuracy {shipped['accuracy']:.1%} on {shipped['windows']} windows" if shipped else ""
     log(f"wrote {out} and {card_path(out).name} (sha256 {card['sha256'][:12]}…){acc}")
 
 
-def _calibration(result, seed: int, calib_windows: int = 256) -> dict:
+def _calibration(result, seed: int, preprocessing: str, calib_windows: int = 256) -> dict:
     """Normalised calibration windows for int8 quantisation, drawn from the training set."""
     import numpy as np
 
@@ -148,10 +160,10 @@ def _calibration(result, seed: int, calib_windows: int = 256) -> dict:
     rng = np.random.default_rng([seed, 0xC0A1])
     tr = np.sort(rng.choice(result["train_indices"], min(calib_windows, len(result["train_indices"])), replace=False))
     b = ds.gather(tr)
-    return {"calib": {n: normalize_window(b[n]) for n in ds.inputs}}
+    return {"calib": {n: normalize_window(b[n], preprocessing) for n in ds.inputs}}
 
 
-def _evaluation(result) -> dict | None:
+def _evaluation(result, preprocessing: str) -> dict | None:
     """The validation windows as the exported graph sees them, with each one's visibility and scene."""
     import numpy as np
 
@@ -167,7 +179,7 @@ def _evaluation(result) -> dict | None:
         visibility = vds.visibility()[idx]
     except WallcliError:  # a dataset that does not record its movers' SNR: no visible-window figures
         visibility = None
-    return {"feeds": {n: normalize_window(vb[n]) for n in vds.inputs}, "labels": vb["label"],
+    return {"feeds": {n: normalize_window(vb[n], preprocessing) for n in vds.inputs}, "labels": vb["label"],
             "visibility": visibility, "scenes": vds.scene_ids()[idx]}
 
 

@@ -13,12 +13,12 @@ from pathlib import Path
 from typing import Any
 
 from wallcli.errors import WallcliError
-from wallcli.signal.window import NORMALIZATION
+from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT
 
 CARD_FORMAT = "wallcli.model-card"
 CARD_VERSION = 1
-# Name and version of the one preprocessing both training and inference apply (defined
-# beside normalize_window, so a change there changes what cards must say).
+# Name and version of the preprocessing that training and inference apply by default (defined
+# beside normalize_window, so a change there changes what cards must say); a card names its own.
 PREPROCESSING = NORMALIZATION
 INPUT_LAYOUT = "NCHW"
 INPUT_AXES = ["batch", "channel", "space", "time"]
@@ -81,8 +81,9 @@ def validate_card(card: Any, where: Path | str = "model card") -> None:
     task = card["task"]
     if task not in TASK_INPUTS:
         raise bad(f"unknown task {task!r}")
-    if card["preprocessing"] != PREPROCESSING:
-        raise bad(f"unsupported preprocessing {card['preprocessing']!r} (this wallcli applies {PREPROCESSING!r})")
+    if card["preprocessing"] not in NORMALIZATION_TEXT:
+        raise bad(f"unsupported preprocessing {card['preprocessing']!r} (this wallcli applies "
+                  f"{' or '.join(repr(k) for k in NORMALIZATION_TEXT)})")
     if not isinstance(card["classes"], list) or len(card["classes"]) < 2:
         raise bad("classes must be a list of at least 2 labels")
     names = [i.get("name") for i in card["inputs"] if isinstance(i, dict)]

@@ -2,7 +2,7 @@
 
 Windows of ``model.window`` samples at the model's canonical rate (30 fps) every ``stride``
 samples, the last one aligned to the end of the clip (``window_starts``).  Each window goes
-through ``normalize_window`` exactly as in training.
+through ``normalize_window`` (the version the model's card names) exactly as in training.
 
 Clip-level probabilities are the mean of the window probabilities.  Averaging (rather than
 a product of probabilities or a majority vote) keeps the answer a proper distribution,
@@ -17,7 +17,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from wallcli.errors import WallcliError
-from wallcli.signal.window import StreamWindower, normalize_window, resample, window_starts
+from wallcli.signal.window import StreamWindower, resample, window_starts
 
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
 
@@ -73,7 +73,7 @@ def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
     probs = []
     for i in range(0, len(starts), CHUNK):
         chunk = starts[i:i + CHUNK]
-        feed = {name: normalize_window(np.stack([p[:, s:s + model.window] for s in chunk]))
+        feed = {name: model.normalize(np.stack([p[:, s:s + model.window] for s in chunk]))
                 for name, p in plots.items()}
         probs.append(model.predict(feed))
     return _result(model, [grid[s] for s in starts], np.concatenate(probs), stride=stride, source=source)
@@ -83,7 +83,7 @@ def _predict_window(model, win: np.ndarray) -> np.ndarray:
     """Probabilities of one (2*bins, window, 3) window, horizontal rows first."""
     b = model.bins
     parts = {"horizontal": win[:b], "vertical": win[b:]}
-    return model.predict({n: normalize_window(parts[n][None]) for n in model.input_names})[0]
+    return model.predict({n: model.normalize(parts[n][None]) for n in model.input_names})[0]
 
 
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,

@@ -11,6 +11,12 @@ Decisions (seed notes are silent on them):
   divide by the window's RMS over everything. Signals span orders of magnitude (distance^-4,
   light level, exposure); dividing by the RMS makes the input scale-free while keeping the
   relative strength of colours and positions.
+- ``normalize_window`` version 2 (``--preprocessing v2`` in training; the card says which one a
+  model needs): the same mean removal, then the window in units of its frame-to-frame noise
+  (sigma^2 = half the mean square of the frame differences, seed notes section 4), compressed
+  by asinh. Version 1 lets the strongest mover set the scale, so a second person 20 dB fainter
+  but well above the noise comes out tiny; in noise units every mover above the noise is of
+  order one or more, and asinh keeps a mover 1000x over the noise within about 8.
 """
 
 from __future__ import annotations
@@ -24,7 +30,15 @@ CANONICAL_FPS = 30.0
 WINDOW = 256
 BINS = 64
 DEFAULT_STRIDE = 64
-NORMALIZATION = "wallcli.signal.window.normalize_window v1"
+NORMALIZATION = "wallcli.signal.window.normalize_window v1"  # the default, and what older cards say
+NORMALIZATION_V2 = "wallcli.signal.window.normalize_window v2"
+NORMALIZATION_TEXT = {
+    NORMALIZATION: "per (bin, colour) temporal mean over the window removed, then divided by the window's "
+                   "global RMS; channels first (N, 3, bins, time)",
+    NORMALIZATION_V2: "per (bin, colour) temporal mean over the window removed, divided by the window's "
+                      "frame-to-frame noise sigma (sigma^2 = half the mean square of the differences between "
+                      "consecutive samples, over all bins and colours), then asinh; channels first (N, 3, bins, time)",
+}
 
 
 def resample(plot: np.ndarray, time: np.ndarray, fps: float = CANONICAL_FPS) -> tuple[np.ndarray, np.ndarray]:
@@ -52,13 +66,25 @@ def window_starts(length: int, window: int = WINDOW, stride: int = DEFAULT_STRID
     return starts
 
 
-def normalize_window(x: np.ndarray) -> np.ndarray:
-    """(..., bins, WINDOW, 3) plot windows -> float32 (..., 3, bins, WINDOW) network input."""
+def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION) -> np.ndarray:
+    """(..., bins, WINDOW, 3) plot windows -> float32 (..., 3, bins, WINDOW) network input.
+
+    ``preprocessing``: a model card's ``preprocessing`` (one of NORMALIZATION_TEXT's keys).
+    """
     x = np.asarray(x, np.float32)
     x = x - x.mean(axis=-2, keepdims=True)
-    rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=(-3, -2, -1), keepdims=True)).astype(np.float32)
-    x = x / np.maximum(rms, 1e-8)
-    return np.ascontiguousarray(np.moveaxis(x, -1, -3))
+    axes = (-3, -2, -1)
+    rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
+    if preprocessing == NORMALIZATION:
+        x = x / np.maximum(rms, 1e-8)
+    elif preprocessing == NORMALIZATION_V2:
+        d = np.diff(x, axis=-2)
+        sigma = np.sqrt(0.5 * np.mean(np.square(d, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
+        # a window without frame noise (a synthetic or heavily filtered plot) must not divide by zero
+        x = np.arcsinh(x / np.maximum(sigma, np.maximum(1e-3 * rms, 1e-8)))
+    else:
+        raise ValueError(f"unknown preprocessing {preprocessing!r}")
+    return np.ascontiguousarray(np.moveaxis(x.astype(np.float32, copy=False), -1, -3))
 
 
 class StreamResampler:

@@ -20,7 +20,7 @@ import torch
 from wallcli.errors import WallcliError
 from wallcli.infer.card import (CARD_FORMAT, CARD_VERSION, OUTPUT_NAME, PREPROCESSING, card_path,
                                 input_spec, sha256_file, write_card)
-from wallcli.signal.window import BINS, CANONICAL_FPS, DEFAULT_STRIDE, WINDOW
+from wallcli.signal.window import BINS, CANONICAL_FPS, DEFAULT_STRIDE, NORMALIZATION_TEXT, WINDOW
 from wallcli.train.nets import WithSoftmax
 
 OPSET = 17
@@ -76,6 +76,7 @@ def _measured(validation: dict[str, Any] | None, probs: np.ndarray, evaluation: 
 
 
 def build_card(*, name: str, version: str, task: str, classes: list[Any], input_names: list[str],
+               preprocessing: str = PREPROCESSING, normalisation: str | None = None,
                sha256: str, size_bytes: int, parameters: int, stride: int = DEFAULT_STRIDE,
                training_data: dict[str, Any], training: dict[str, Any], validation: dict[str, Any] | None,
                onnx_file: str, parity: float, quantization: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -84,9 +85,8 @@ def build_card(*, name: str, version: str, task: str, classes: list[Any], input_
         "name": name, "version": version, "task": task, "classes": list(classes),
         "inputs": [input_spec(n, BINS, WINDOW) for n in input_names],
         "output": {"name": OUTPUT_NAME, "shape": [None, len(classes)], "meaning": "class probabilities (softmax)"},
-        "preprocessing": PREPROCESSING,
-        "normalisation": "per (bin, colour) temporal mean over the window removed, then divided by the "
-                         "window's global RMS; channels first (N, 3, bins, time)",
+        "preprocessing": preprocessing,
+        "normalisation": normalisation or NORMALIZATION_TEXT[preprocessing],
         "fps": int(CANONICAL_FPS) if float(CANONICAL_FPS).is_integer() else CANONICAL_FPS, "window": WINDOW, "bins": BINS, "stride": stride,
         "clip_aggregation": "mean of window probabilities",
         "onnx": {"file": onnx_file, "opset": OPSET, "bytes": size_bytes, "parameters": parameters,

@@ -30,6 +30,7 @@ import torch
 from torch import nn
 
 from wallcli.errors import WallcliError
+from wallcli.signal.window import NORMALIZATION
 from wallcli.train.augment import augment, superpose
 from wallcli.train.data import ShardDataset, split_validation
 from wallcli.train.nets import build
@@ -61,20 +62,21 @@ class TrainConfig:
     ema: float = 0.995  # per-step decay of the weight average (0: no averaging)
     select: str = "last"  # export the last epoch's weights, or the "best" on validation
     superpose: float = 0.0  # count: fraction of windows summed with another (augment.superpose)
+    preprocessing: str = NORMALIZATION  # which normalize_window the net is trained on (the card records it)
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
 
 
-def _to_tensor(x: np.ndarray, channels_last: bool) -> torch.Tensor:
+def _to_tensor(x: np.ndarray, channels_last: bool, preprocessing: str = NORMALIZATION) -> torch.Tensor:
     from wallcli.signal.window import normalize_window
 
-    t = torch.from_numpy(np.ascontiguousarray(normalize_window(x), dtype=np.float32))
+    t = torch.from_numpy(np.ascontiguousarray(normalize_window(x, preprocessing), dtype=np.float32))
     return t.contiguous(memory_format=torch.channels_last) if channels_last else t
 
 
 def evaluate(net: nn.Module, ds: ShardDataset, indices: np.ndarray, batch_size: int,
-             channels_last: bool = False) -> dict[str, Any]:
+             channels_last: bool = False, preprocessing: str = NORMALIZATION) -> dict[str, Any]:
     """Accuracy, mean loss and confusion matrix (rows: true class, columns: predicted)."""
     k = len(ds.classes)
     cm = np.zeros((k, k), np.int64)
@@ -84,7 +86,7 @@ def evaluate(net: nn.Module, ds: ShardDataset, indices: np.ndarray, batch_size: 
     with torch.no_grad():
         for idx in ds.plan(indices, batch_size, np.random.default_rng(0), shuffle=False):
             b = ds.gather(idx)
-            logits = net(*[_to_tensor(b[n], channels_last) for n in ds.inputs])
+            logits = net(*[_to_tensor(b[n], channels_last, preprocessing) for n in ds.inputs])
             y = torch.from_numpy(b["label"])
             loss_sum += float(nn.functional.cross_entropy(logits, y, reduction="sum"))
             np.add.at(cm, (b["label"], logits.argmax(1).numpy()), 1)
@@ -117,7 +119,8 @@ def _save_checkpoint(path: Path, state: dict[str, Any]) -> None:
 def _identity(cfg: TrainConfig, ds: ShardDataset) -> dict[str, Any]:
     # what must match for a checkpoint to be resumable into this run
     return {"task": cfg.task, "windows": ds.n, "dataset_seed": [m.get("seed") for m in ds.manifests], "ema": cfg.ema,
-            "superpose": cfg.superpose, "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None}
+            "superpose": cfg.superpose, "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None,
+            **({} if cfg.preprocessing == NORMALIZATION else {"preprocessing": cfg.preprocessing})}
 
 
 def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
@@ -186,7 +189,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
                     b = superpose(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0x5AB]), cfg.superpose)
                 if cfg.augment:
                     b = augment(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0xA06]))
-                xs = [_to_tensor(b[n], cfg.channels_last) for n in ds.inputs]
+                xs = [_to_tensor(b[n], cfg.channels_last, cfg.preprocessing) for n in ds.inputs]
                 y = torch.from_numpy(b["label"])
                 opt.zero_grad(set_to_none=True)
                 logits = net(*xs)
@@ -215,7 +218,8 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         if ema is not None:
             eval_net = copy.deepcopy(net)
             eval_net.load_state_dict(ema)
-        val = evaluate(eval_net, val_ds, val_idx, max(cfg.batch_size, 64), cfg.channels_last) if len(val_idx) else None
+        val = (evaluate(eval_net, val_ds, val_idx, max(cfg.batch_size, 64), cfg.channels_last, cfg.preprocessing)
+               if len(val_idx) else None)
         rec = {"epoch": epoch + 1, "train_loss": loss_sum / seen if seen else None,
                "train_accuracy": correct / seen if seen else None, "train_windows_per_s": seen / max(time.monotonic() - t0, 1e-9),
                "val_accuracy": val["accuracy"] if val else None, "val_loss": val["loss"] if val else None}

@@ -1,0 +1,57 @@
+"""What the networks see: window normalisation v1 (RMS) and v2 (noise units, asinh)."""
+import numpy as np
+import pytest
+
+from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2, normalize_window
+
+
+def _window(strong: float, faint: float, sigma: float = 1.0, seed: int = 0) -> np.ndarray:
+    """(64, 256, 3): a strong slow mover at bins 10-20, a faint one at 40-50, white noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(256) / 30.0
+    x = rng.normal(0.0, sigma, (64, 256, 3))
+    x[10:20] += strong * np.sin(2 * np.pi * 0.3 * t)[None, :, None]
+    x[40:50] += faint * np.sin(2 * np.pi * 0.5 * t + 1.0)[None, :, None]
+    return (x + 120.0).astype(np.float32)  # a wall level that both versions remove
+
+
+@pytest.mark.parametrize("prep", list(NORMALIZATION_TEXT))
+def test_layout_and_scale_invariance(prep):
+    x = _window(50.0, 3.0)
+    y = normalize_window(x, prep)
+    assert y.shape == (3, 64, 256) and y.dtype == np.float32
+    if prep == NORMALIZATION:  # (asinh of a zero-mean signal need not be zero-mean)
+        assert np.allclose(y.mean(axis=-1), 0.0, atol=1e-3) and np.isclose(np.sqrt(np.mean(y**2)), 1.0, atol=1e-3)
+    # exposure or gain scale every value alike: the input must not change
+    assert np.allclose(normalize_window(7.0 * (x - 120.0) + 30.0, prep), y, atol=1e-3)
+    batch = normalize_window(np.stack([x, _window(0.0, 0.0, seed=1)]), prep)
+    assert batch.shape == (2, 3, 64, 256) and np.allclose(batch[0], y, atol=1e-6)
+
+
+def test_v2_is_in_units_of_the_frame_noise():
+    y = normalize_window(_window(0.0, 0.0, sigma=3.0), NORMALIZATION_V2)
+    # pure white noise: x / sigma ~ N(0, 1), asinh of which has RMS ~0.8
+    assert 0.75 < float(np.sqrt(np.mean(y**2))) < 0.85
+
+
+def test_v2_keeps_a_faint_second_mover_that_v1_scales_away():
+    x = _window(strong=300.0, faint=6.0)  # 50 dB above the noise, and 15 dB
+
+    def ratio(prep):
+        y = normalize_window(x, prep)
+        return float(np.abs(y[:, 40:50]).max() / np.abs(y[:, 10:20]).max())
+
+    assert ratio(NORMALIZATION) < 0.05  # the faint mover is a few % of the input's range
+    assert ratio(NORMALIZATION_V2) > 0.3  # over a third of it: the net can see it
+
+
+def test_unknown_preprocessing_is_refused():
+    with pytest.raises(ValueError, match="unknown preprocessing"):
+        normalize_window(_window(1.0, 0.0), "v9")
+
+
+def test_v2_survives_a_window_without_frame_noise():
+    x = np.zeros((64, 256, 3), np.float32)
+    x[5] = np.linspace(0, 1, 256)[:, None]  # a smooth ramp, no noise at all
+    assert np.all(np.isfinite(normalize_window(x, NORMALIZATION_V2)))
+    assert np.all(normalize_window(np.zeros((64, 256, 3), np.float32), NORMALIZATION_V2) == 0)
