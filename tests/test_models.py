@@ -45,3 +45,19 @@ def test_corrupt_plot_file(tmp_path, run_cli, task):
     code, out, err = run_cli(task, bad, "--json")
     assert code == 1 and out == ""
     assert len(err.strip().splitlines()) == 1 and err.startswith("Error:") and "npz" in err
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
+def test_shipped_cards_carry_the_measured_accuracy_and_the_table_says_it(task, golden_clip, run_cli):
+    card = json.loads((Path(__file__).resolve().parents[1] / "models" / f"{task}.json").read_text())
+    v = card["validation"]
+    vis = v["visible"]
+    assert v["scenes"] < v["windows"] and vis["windows"] < v["windows"]
+    for block in (v, vis):
+        lo, hi = block["accuracy_95ci"]
+        assert lo <= block["accuracy"] <= hi
+    assert np.array(vis["confusion_matrix"]).sum() == vis["windows"]
+    code, out, err = run_cli(task, golden_clip)
+    assert code == 0, err
+    assert f"right on {vis['accuracy']:.0%} (95 % CI {vis['accuracy_95ci'][0]:.0%}" in err
+    assert "right on" not in out  # the note is for the reader, on stderr
