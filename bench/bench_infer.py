@@ -81,10 +81,13 @@ def bench_windows(paths: dict[str, Path], threads: int, repeat: int) -> None:
 
     rng = np.random.default_rng(0)
     raw = rng.normal(size=(32, 64, 256, 3)).astype(np.float32)
-    t0 = time.perf_counter()
-    for _ in range(repeat):
-        normalize_window(raw)
-    print(f"normalize_window: {(time.perf_counter() - t0) / repeat / 32 * 1000:.3f} ms per window")
+    from wallcli.signal.window import NORMALIZATION_TEXT
+
+    for prep in NORMALIZATION_TEXT:
+        t0 = time.perf_counter()
+        for _ in range(repeat):
+            normalize_window(raw, prep)
+        print(f"normalize_window {prep.split()[-1]}: {(time.perf_counter() - t0) / repeat / 32 * 1000:.3f} ms per window")
     for task, path in paths.items():
         if task.endswith(" int8"):  # a bare session: the copy has no card of its own
             import onnxruntime as ort

@@ -71,20 +71,26 @@ def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION) -> np.nd
 
     ``preprocessing``: a model card's ``preprocessing`` (one of NORMALIZATION_TEXT's keys).
     """
-    x = np.asarray(x, np.float32)
-    x = x - x.mean(axis=-2, keepdims=True)
     axes = (-3, -2, -1)
-    rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
     if preprocessing == NORMALIZATION:
+        x = np.asarray(x, np.float32)
+        x = x - x.mean(axis=-2, keepdims=True)
+        rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
         x = x / np.maximum(rms, 1e-8)
-    elif preprocessing == NORMALIZATION_V2:
-        d = np.diff(x, axis=-2)
-        sigma = np.sqrt(0.5 * np.mean(np.square(d, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
-        # a window without frame noise (a synthetic or heavily filtered plot) must not divide by zero
-        x = np.arcsinh(x / np.maximum(sigma, np.maximum(1e-3 * rms, 1e-8)))
-    else:
+        return np.ascontiguousarray(np.moveaxis(x, -1, -3))
+    if preprocessing != NORMALIZATION_V2:
         raise ValueError(f"unknown preprocessing {preprocessing!r}")
-    return np.ascontiguousarray(np.moveaxis(x.astype(np.float32, copy=False), -1, -3))
+    # channels first before reducing over time: the time axis is then contiguous (20x faster)
+    x = np.ascontiguousarray(np.moveaxis(np.asarray(x, np.float32), -1, -3))
+    x -= x.mean(axis=-1, keepdims=True)
+    rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
+    d = np.diff(x, axis=-1)
+    sigma = np.sqrt(0.5 * np.mean(np.square(d, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)
+    # a window without frame noise (a synthetic or heavily filtered plot) must not divide by zero
+    x /= np.maximum(sigma, np.maximum(1e-3 * rms, 1e-8))
+    # asinh as log(|z| + sqrt(z^2 + 1)): numpy's float32 arcsinh is twice as slow; same to 3e-7
+    a = np.abs(x)
+    return np.copysign(np.log(a + np.sqrt(a * a + 1.0)), x).astype(np.float32, copy=False)
 
 
 class StreamResampler:
