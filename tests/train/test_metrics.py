@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from wallcli.train.data import ShardDataset
 from wallcli.train.metrics import breakdown, scene_bootstrap
@@ -46,3 +47,21 @@ def test_scene_ids_follow_the_shards_scene_records(make_dataset):
     assert ds.scene_ids().tolist() == [0, 0, 1, 1, 2, 2, 3, 3, 4, 4]  # two windows per scene, across shards
     plain = ShardDataset(make_dataset("count", 4, shards=1, name="plain"), "count")
     assert plain.scene_ids().tolist() == [0, 1, 2, 3]  # no scene records: each window its own
+
+
+def test_paired_difference_is_tighter_than_two_intervals():
+    from wallcli.train.metrics import paired_difference
+
+    rng = np.random.default_rng(0)
+    scenes = np.repeat(np.arange(50), 4)
+    hard = np.repeat(rng.random(50) < 0.4, 4)  # both models fail the hard scenes
+    a = ~hard
+    b = a.copy()
+    b[np.flatnonzero(a)[::10]] = False  # b also misses one easy window in ten
+    d = paired_difference(a, b, scenes)
+    assert d["difference"] == pytest.approx((a.sum() - b.sum()) / len(a))
+    lo, hi = d["difference_95ci"]
+    assert 0 < lo <= d["difference"] <= hi  # the gain is certain although...
+    ia, ib = scene_bootstrap(a, scenes), scene_bootstrap(b, scenes)
+    assert ia[0] < ib[1]  # ...the two models' own intervals overlap
+    assert paired_difference(a, a, scenes) == {"difference": 0.0, "difference_95ci": [0.0, 0.0]}
