@@ -18,7 +18,7 @@ import numpy as np
 
 from wallcli.infer.model import load_model
 from wallcli.train.data import ShardDataset
-from wallcli.train.metrics import VISIBLE_DB, breakdown, paired_difference
+from wallcli.train.metrics import VISIBLE_DB, breakdown, paired_difference, visible_mask
 
 
 def _predict(task: str, ds: ShardDataset, model_path: str | None):
@@ -41,7 +41,7 @@ def evaluate(task: str, data: str, model_path: str | None = None, visible_db: fl
     if against is not None:
         other, q, _ = _predict(task, ds, against)
         a, b = p.argmax(1) == y, q.argmax(1) == y
-        seen = np.isnan(vis) | (np.nan_to_num(vis, nan=-np.inf) >= visible_db)
+        seen = visible_mask(vis, visible_db)
         out["against"] = {"model": other.info(), "all": paired_difference(a, b, scenes),
                           "visible": paired_difference(a[seen], b[seen], scenes[seen])}
     return out

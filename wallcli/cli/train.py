@@ -167,13 +167,12 @@ def _evaluation(result, preprocessing: str) -> dict | None:
     """The validation windows as the exported graph sees them, with each one's visibility and scene."""
     import numpy as np
 
+    from wallcli.errors import WallcliError
     from wallcli.signal.window import normalize_window
 
     vds, idx = result["eval_dataset"], np.asarray(result["val_indices"])
     if not len(idx):
         return None
-    from wallcli.errors import WallcliError
-
     vb = vds.gather(idx)
     try:
         visibility = vds.visibility()[idx]

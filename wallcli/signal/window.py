@@ -73,6 +73,8 @@ def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION) -> np.nd
     """
     axes = (-3, -2, -1)
     if preprocessing == NORMALIZATION:
+        # kept operation for operation as the shipped models were trained and their goldens recorded
+        # (v2's faster channels-first order would move int8 inputs across quantisation steps)
         x = np.asarray(x, np.float32)
         x = x - x.mean(axis=-2, keepdims=True)
         rms = np.sqrt(np.mean(np.square(x, dtype=np.float64), axis=axes, keepdims=True)).astype(np.float32)

@@ -29,6 +29,11 @@ def confusion(labels: np.ndarray, pred: np.ndarray, k: int) -> np.ndarray:
     return cm
 
 
+def visible_mask(visibility: np.ndarray, visible_db: float = VISIBLE_DB) -> np.ndarray:
+    """Windows with nobody moving (NaN) or every mover at least ``visible_db``."""
+    return np.isnan(visibility) | (np.nan_to_num(visibility, nan=-np.inf) >= visible_db)
+
+
 def scene_bootstrap(correct: np.ndarray, scenes: np.ndarray, n: int = 2000, seed: int = 0) -> list[float] | None:
     """95 % interval of the accuracy, resampling whole scenes with replacement."""
     if len(correct) == 0:
@@ -82,7 +87,7 @@ def breakdown(probs: np.ndarray, labels: np.ndarray, visibility: np.ndarray | No
     if visibility is None:
         return out
     movers = ~np.isnan(visibility)
-    vis = ~movers | (np.nan_to_num(visibility, nan=-np.inf) >= visible_db)
+    vis = visible_mask(visibility, visible_db)
     bands = []
     for lo, hi in zip(SNR_EDGES[:-1], SNR_EDGES[1:]):
         sel = movers & (visibility >= lo) & (visibility < hi)
