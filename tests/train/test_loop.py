@@ -6,7 +6,7 @@ torch = pytest.importorskip("torch")
 from wallcli.errors import WallcliError  # noqa: E402
 from wallcli.train.augment import augment  # noqa: E402
 from wallcli.train.data import ShardDataset, split_validation  # noqa: E402
-from wallcli.train.loop import TrainConfig, train  # noqa: E402
+from wallcli.train.loop import ANNEAL_FLOOR, TrainConfig, learning_rate, train  # noqa: E402
 
 
 def test_dataset_plan_covers_indices_once(make_dataset):
@@ -69,15 +69,28 @@ def test_two_epochs_reduce_loss_and_checkpoint(make_dataset, tmp_path):
     assert v["windows"] == 8 and np.array(v["confusion_matrix"]).sum() == 8
 
 
-def test_interrupted_run_resumes_exactly(make_dataset, tmp_path):
+def test_anneal_keeps_the_seeds_rate_then_falls_to_the_floor(tmp_path):
+    cfg = _cfg(tmp_path, tmp_path, epochs=5)
+    assert {learning_rate(cfg, e, b, 10) for e in range(5) for b in range(10)} == {1e-3}  # no --anneal
+    cfg.anneal = 2
+    rates = [learning_rate(cfg, e, b, 10) for e in range(5) for b in range(10)]
+    assert set(rates[:30]) == {1e-3}  # epochs 1-3 at the seed's rate
+    tail = rates[30:]
+    assert all(a > b for a, b in zip(tail[1:], tail[2:]))  # falls step by step
+    assert tail[-1] < 0.01 * 1e-3 * 2 and learning_rate(cfg, 5, 0, 10) == pytest.approx(1e-3 * ANNEAL_FLOOR)
+    assert learning_rate(cfg, 4, 0, 10) == pytest.approx(1e-3 * ANNEAL_FLOOR + (1e-3 - 1e-3 * ANNEAL_FLOOR) / 2)
+
+
+@pytest.mark.parametrize("anneal", [0, 1])
+def test_interrupted_run_resumes_exactly(make_dataset, tmp_path, anneal):
     data = make_dataset("count", 28)
-    straight = train(_cfg(tmp_path, data, out=tmp_path / "a.onnx", epochs=2, batch_size=8))
+    straight = train(_cfg(tmp_path, data, out=tmp_path / "a.onnx", epochs=2, batch_size=8, anneal=anneal))
 
     def stop_after_two_steps(kind, **f):
         if kind == "step" and f["epoch"] == 1 and f["batch"] == 1:
             raise KeyboardInterrupt
 
-    cfg = _cfg(tmp_path, data, out=tmp_path / "b.onnx", epochs=2, batch_size=8)
+    cfg = _cfg(tmp_path, data, out=tmp_path / "b.onnx", epochs=2, batch_size=8, anneal=anneal)
     with pytest.raises(KeyboardInterrupt):
         train(cfg, stop_after_two_steps)
     ck = torch.load(cfg.checkpoint_path(), weights_only=False)

@@ -37,6 +37,9 @@ def train(
                                                "noise-free signal is this many dB below the plot noise or more (per-window "
                                                "snr_db from the simulator); windows with nobody moving always stay. "
                                                "Validation keeps every window."),
+    anneal: int = typer.Option(0, "--anneal", min=0, help="Lower the learning rate over the last N epochs (cosine, "
+                               "1e-3 down to 1e-5); 0: the seed's constant 1e-3 throughout. Raising --epochs with "
+                               "--anneal on a finished run continues it from its checkpoint."),
     ema: float = typer.Option(0.995, "--ema", min=0.0, max=0.9999, help="Per-step decay of the moving average of the "
                               "weights that is validated and exported (0: the raw weights)."),
     select: str = typer.Option("last", "--select", help="Export the weights after the last epoch ('last': the card's "
@@ -83,12 +86,14 @@ def train(
     from wallcli.io.writer import check_outputs
     from wallcli.train.augment import DESCRIPTION, SUPERPOSE_DESCRIPTION
     from wallcli.train.export import export_model
-    from wallcli.train.loop import TrainConfig, train as run_training
+    from wallcli.train.loop import ANNEAL_FLOOR, TrainConfig, train as run_training
 
     if select not in ("last", "best"):
         raise UsageError(f"--select must be last or best (got {select!r})")
     if quantize not in ("none", "int8"):
         raise UsageError(f"--quantize must be none or int8 (got {quantize!r})")
+    if anneal > epochs:
+        raise UsageError(f"--anneal {anneal} is more than --epochs {epochs}")
     if superpose > 0 and task.value != "count":
         raise UsageError("--superpose applies to count only (people add up; activities do not)")
     from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2
@@ -103,7 +108,8 @@ def train(
     cfg = TrainConfig(task=task.value, data=list(data), out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
-                      min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep)
+                      min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
+                      anneal=anneal)
 
     _sigterm_interrupts()
     with _TrainProgress(console_err) as bar:
@@ -128,6 +134,8 @@ def train(
         training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
         training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
+                  **({"lr_schedule": f"constant {cfg.lr:g}, then cosine to {cfg.lr * ANNEAL_FLOOR:g} over the last {anneal} epochs"}
+                     if anneal else {}),
                   "loss": "cross-entropy", "augmentation": ([SUPERPOSE_DESCRIPTION.format(p=superpose)] if superpose > 0 else [])
                   + (DESCRIPTION if augment else []),
                   "weight_average": {"ema_decay_per_step": ema, "exported": select},
@@ -139,6 +147,7 @@ def train(
                              + (f" --superpose {superpose:g}" if superpose > 0 else "")
                              + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")
                              + (f" --quantize {quantize}" if quantize != "none" else "")
+                             + (f" --anneal {anneal}" if anneal else "")
                              + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")},
         validation=validation,
     )
