@@ -1,6 +1,10 @@
 """`wallcli simulate` end to end: video + sidecar + preview, determinism, usage errors."""
 
 import json
+import os
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -48,3 +52,17 @@ def test_simulate_flatland_mp4(tmp_path, run_cli):
 def test_simulate_usage_errors_exit_2(tmp_path, run_cli, args):
     code, _, err = run_cli("simulate", "-o", tmp_path / "x.mp4", *args)
     assert code == 2 and "Error:" in err
+
+
+@pytest.mark.skipif(shutil.which("taskset") is None or len(os.sched_getaffinity(0)) < 2,
+                    reason="needs taskset and two CPUs")
+def test_simulated_h264_does_not_depend_on_the_number_of_cores(tmp_path):
+    """x264's output changes with its thread count, and FFmpeg's default is one per core: the
+    same seed must give the same file on a laptop and on a 64-core server (CONTRACT.md)."""
+    args = [sys.executable, "-m", "wallcli", "simulate", "--people", "1", "--seed", "3", "--duration", "1",
+            "--size", "640x360"]
+    one, all_ = tmp_path / "one.mp4", tmp_path / "all.mp4"
+    subprocess.run(["taskset", "-c", str(min(os.sched_getaffinity(0))), *args, "-o", str(one)], check=True,
+                   capture_output=True)
+    subprocess.run([*args, "-o", str(all_)], check=True, capture_output=True)
+    assert one.read_bytes() == all_.read_bytes()
