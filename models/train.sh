@@ -21,12 +21,14 @@ $W simulate --dataset 1024 --task activity -o data/val_activity3 --jobs "$JOBS" 
 
 # Training sets place people where their light reaches the camera above its noise (--placement
 # visible, the default).
-# count 0.4.0, as shipped: moving people only, a quarter flatland, superposition augmentation
+# count 0.4.0 (shipped as 0.4.1: its 8-bit weights rounded to 7 bits by models/requantize.py; this
+# command now quantises to 7 bits from float directly): moving people only, a quarter flatland,
+# superposition augmentation
 $W simulate --dataset 8192 --task count -o data/count4 --jobs "$JOBS" --seed 6 --world mixed
 $W train count --data data/count4 --val data/val_count6 --out models/count.onnx --epochs "$EPOCHS_COUNT" \
   --threads 2 --min-snr-db -10 --select last --superpose 0.25 --quantize int8 --model-version 0.4.0 --force
 
-# activity 0.3.0, as shipped: two training sets from two seeds, used as one
+# activity 0.3.0 (shipped as 0.3.1, likewise): two training sets from two seeds, used as one
 $W simulate --dataset 3072 --task activity -o data/activity2 --jobs "$JOBS" --seed 4
 $W simulate --dataset 8192 --task activity -o data/activity3 --jobs "$JOBS" --seed 7
 $W train activity --data data/activity2 --data data/activity3 --val data/val_activity3 --out models/activity.onnx \

@@ -61,3 +61,20 @@ def test_shipped_cards_carry_the_measured_accuracy_and_the_table_says_it(task, g
     assert code == 0, err
     assert f"right on {vis['accuracy']:.0%} (95 % CI {vis['accuracy_95ci'][0]:.0%}" in err
     assert "right on" not in out  # the note is for the reader, on stderr
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
+def test_shipped_int8_models_compute_the_same_on_every_x86_cpu(task):
+    """x86 u8s8 kernels without VNNI add pairs of products into a saturating int16 (8-bit weights
+    gave the waving example another answer on AVX2 than on AVX-512 VNNI): the shipped weights stay
+    within |w| <= 64, and onnxruntime still runs every convolution as QLinearConv (not float)."""
+    onnx = pytest.importorskip("onnx")
+    from wallcli.infer.model import shipped_model_path
+    from wallcli.train.quantize import MAX_WEIGHT, fused_convolutions, saturation_margin
+
+    path = shipped_model_path(task)
+    model = onnx.load(str(path))
+    convs = sum(n.op_type == "Conv" for n in model.graph.node)
+    assert convs == {"count": 5, "activity": 10}[task]
+    assert 0 < saturation_margin(model) <= MAX_WEIGHT
+    assert fused_convolutions(path) == (convs, 0)

@@ -139,6 +139,11 @@ def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_datas
     assert card["validation"]["windows"] == 10 and "int8" in card["validation"]["measured_on"]
     ops = {n.op_type for n in onnx.load(str(out)).graph.node}
     assert "QuantizeLinear" in ops and "DequantizeLinear" in ops
+    # 7-bit weights (no int16 saturation on AVX2), and every convolution still fused
+    from wallcli.train.quantize import fused_convolutions, saturation_margin
+
+    assert q["max_abs_weight"] == 64 and 0 < saturation_margin(onnx.load(str(out))) <= 64
+    assert fused_convolutions(out) == (10, 0)
     # it runs through the normal inference path
     from wallcli.infer.model import Model
 
