@@ -88,8 +88,8 @@ def quantize_int8(src: Path, dst: Path, calib: dict[str, np.ndarray], batch: int
 
 
 def _quantized_weights(model):
-    """(conv node, int8 weights, scales, dequantize node) for every convolution whose weights
-    come through a DequantizeLinear of an int8 initializer."""
+    """(conv node, int8 weights, scales, their DequantizeLinear node, the initializers by name)
+    for every convolution whose weights come through a DequantizeLinear of an int8 initializer."""
     from onnx import numpy_helper
 
     init = {i.name: i for i in model.graph.initializer}
