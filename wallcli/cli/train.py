@@ -38,7 +38,7 @@ def train(
                                                "snr_db from the simulator); windows with nobody moving always stay. "
                                                "Validation keeps every window."),
     anneal: int = typer.Option(0, "--anneal", min=0, help="Lower the learning rate over the last N epochs (cosine, "
-                               "1e-3 down to 1e-5); 0: the seed's constant 1e-3 throughout. Raising --epochs with "
+                               "down to 1/100 of --lr); 0: a constant --lr throughout. Raising --epochs with "
                                "--anneal on a finished run continues it from its checkpoint."),
     ema: float = typer.Option(0.995, "--ema", min=0.0, max=0.9999, help="Per-step decay of the moving average of the "
                               "weights that is validated and exported (0: the raw weights)."),
@@ -55,6 +55,10 @@ def train(
                                       "in the card (inference follows the card): v1 = divided by the window's RMS; v2 = "
                                       "in units of the window's frame-to-frame noise, asinh-compressed, so a faint "
                                       "second mover is not scaled away by a strong first (wallcli/signal/window.py)."),
+    init: Optional[Path] = typer.Option(None, "--init", help="Start from the weights of an exported model of the same "
+                                        "task (its .onnx, float or int8): fine-tuning. The card records which."),
+    lr: float = typer.Option(1e-3, "--lr", min=1e-7, max=1.0, help="RMSProp learning rate (the seed's 1e-3; "
+                             "--anneal ends at 1/100 of it). Lower it to fine-tune from --init."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
@@ -105,11 +109,26 @@ def train(
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     check_outputs([out, card_path(out)], force=force)
+    init_info = None
+    if init is not None:
+        from wallcli.infer.card import read_card
+
+        if not init.is_file():
+            raise UsageError(f"--init model not found: {init}")
+        base = read_card(init)  # its card says which model it is (and checks nothing else here)
+        if base.get("task") != task.value:
+            raise UsageError(f"--init {init} is a {base.get('task')!r} model, not {task.value!r}")
+        if base.get("preprocessing") != prep:
+            raise UsageError(f"--init {init} was trained on {base.get('preprocessing')}, this run on {prep}")
+        from wallcli.infer.card import sha256_file
+
+        init_info = {"name": base.get("name"), "version": base.get("version"), "sha256": sha256_file(init),
+                     "path": str(init)}
     cfg = TrainConfig(task=task.value, data=list(data), out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
                       min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
-                      anneal=anneal)
+                      anneal=anneal, init=init, lr=lr)
 
     _sigterm_interrupts()
     with _TrainProgress(console_err) as bar:
@@ -133,7 +152,7 @@ def train(
         preprocessing=prep, normalisation=NORMALIZATION_TEXT[prep],
         training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
-        training={"seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
+        training={**({"init": init_info} if init_info else {}), "seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
                   **({"lr_schedule": f"constant {cfg.lr:g}, then cosine to {cfg.lr * ANNEAL_FLOOR:g} over the last {anneal} epochs"}
                      if anneal else {}),
                   "loss": "cross-entropy", "augmentation": ([SUPERPOSE_DESCRIPTION.format(p=superpose)] if superpose > 0 else [])
@@ -148,6 +167,8 @@ def train(
                              + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")
                              + (f" --quantize {quantize}" if quantize != "none" else "")
                              + (f" --anneal {anneal}" if anneal else "")
+                             + (f" --lr {lr:g}" if lr != 1e-3 else "")
+                             + (f" --init {init}" if init is not None else "")
                              + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")},
         validation=validation,
     )

@@ -30,6 +30,7 @@ import torch
 from torch import nn
 
 from wallcli.errors import WallcliError
+from wallcli.infer.card import sha256_file
 from wallcli.signal.window import NORMALIZATION
 from wallcli.train.augment import augment, superpose
 from wallcli.train.data import ShardDataset, split_validation
@@ -79,6 +80,7 @@ class TrainConfig:
     select: str = "last"  # export the last epoch's weights, or the "best" on validation
     superpose: float = 0.0  # count: fraction of windows summed with another (augment.superpose)
     preprocessing: str = NORMALIZATION  # which normalize_window the net is trained on (the card records it)
+    init: Path | None = None  # an exported model (.onnx) whose weights training starts from
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
@@ -136,7 +138,9 @@ def _identity(cfg: TrainConfig, ds: ShardDataset) -> dict[str, Any]:
     # what must match for a checkpoint to be resumable into this run
     return {"task": cfg.task, "windows": ds.n, "dataset_seed": [m.get("seed") for m in ds.manifests], "ema": cfg.ema,
             "superpose": cfg.superpose, "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None,
-            **({} if cfg.preprocessing == NORMALIZATION else {"preprocessing": cfg.preprocessing})}
+            **({} if cfg.preprocessing == NORMALIZATION else {"preprocessing": cfg.preprocessing}),
+            **({} if cfg.init is None else {"init": sha256_file(Path(cfg.init))}),
+            **({} if cfg.lr == 1e-3 else {"lr": cfg.lr})}
 
 
 def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
@@ -157,6 +161,13 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         raise WallcliError(f"{cfg.data} has too few windows to train on ({ds.n})")
 
     net = build(cfg.task)
+    if cfg.init is not None:
+        from wallcli.train.init import init_from_onnx
+
+        # 64 training windows set the batch-norm statistics the folded graph no longer has
+        pick = np.sort(np.random.default_rng([cfg.seed, 0x1417]).choice(train_idx, min(64, len(train_idx)), replace=False))
+        b = ds.gather(pick)
+        init_from_onnx(net, cfg.init, [_to_tensor(b[n], False, cfg.preprocessing) for n in ds.inputs])
     if cfg.channels_last:
         net = net.to(memory_format=torch.channels_last)
     opt = torch.optim.RMSprop(net.parameters(), lr=cfg.lr)
