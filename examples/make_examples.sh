@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerate the bundled example clips with the simulator (same seed + options = same video).
+# Regenerate the bundled example clips with the simulator (same seed + options = same video, on
+# any machine with AVX2: x264 runs on one thread and without its AVX-512 code; see io/writer.py).
 # A typical camera (0.1 codes per electron, 1.5 codes read noise, H.264 crf 12) watching a wall
 # region of 200k sensor pixels, people 1-2 m from the wall: faint (0.1-1 %) but visible signals.
 set -euo pipefail

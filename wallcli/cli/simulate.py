@@ -178,7 +178,7 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
     # video that is there always has its truth beside it)
     with atomic_paths([sidecar, output], force=force) as (tmp_truth, tmp_video):
         with VideoWriter(tmp_video, fps, w, h, codec=None if codec == "rawvideo" else codec, crf=crf,
-                         pix_fmt=pix_fmt, threads=1) as vw:
+                         pix_fmt=pix_fmt, repeatable=True) as vw:
             with progress("simulate", n) as advance:
                 for frame in scene.frames():
                     vw.write(frame)

@@ -142,7 +142,7 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
     path = Path(name)
     try:
         with VideoWriter(path, cam.fps, cam.width, cam.height, codec=cam.codec, crf=cam.crf,
-                         pix_fmt=video_pix_fmt(cam), preset="veryfast", threads=1) as w:
+                         pix_fmt=video_pix_fmt(cam), preset="veryfast", repeatable=True) as w:
             for frame in scene.frames():
                 w.write(frame)
         with open_video(path) as reader:

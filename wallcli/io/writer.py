@@ -112,6 +112,20 @@ def write_text_atomic(path: str | os.PathLike, text: str, *, force: bool = False
         tmp.write_text(text, encoding="utf-8")
 
 
+def _x264_repeatable() -> dict[str, str]:
+    """x264 options that keep it off its AVX-512 code (see VideoWriter), on CPUs that have it."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_features__ as cpu
+    except ImportError:  # numpy < 2
+        try:
+            from numpy.core._multiarray_umath import __cpu_features__ as cpu
+        except ImportError:
+            return {}
+    # 'AVX2' is x264's name for everything up to AVX2 (SSE..AVX2, FMA3, BMI); only passed where
+    # the CPU has AVX-512, hence AVX2, and never on non-x86 CPUs (where the name is unknown)
+    return {"x264-params": "asm=AVX2"} if cpu.get("AVX512F") and cpu.get("AVX2") else {}
+
+
 class VideoWriter:
     """Encode RGB uint8 frames with PyAV.
 
@@ -130,12 +144,16 @@ class VideoWriter:
         crf: int = 18,
         pix_fmt: str | None = None,
         preset: str = "medium",
-        threads: int = 0,
+        repeatable: bool = False,
     ):
-        """``threads``: encoder threads, 0 for FFmpeg's choice (one per core). x264's output
-        depends on its thread count (measured: the same 40 frames at 1, 2, 4 and 8 threads gave
-        four different files), so with the default a seed would give a different video on a
-        machine with another number of cores; the simulator passes 1."""
+        """``repeatable``: the same frames always give the same file (the simulator's promise:
+        a seed gives one video). Two things in x264 break that by default, both measured here:
+        its output depends on its thread count, and FFmpeg's default is one thread per core
+        (the same 40 frames at 1, 2, 4 and 8 threads gave four different files); and its AVX-512
+        code (PyAV 18.1's x264, core 165) is not repeatable from run to run on smooth, faint
+        content like a simulated wall (10 encodes of one clip's frames in one process: 8
+        different files; with AVX2 code or plain C: always one). So: one thread, and on CPUs with
+        AVX-512, x264 limited to AVX2 (the same code an AVX2 machine runs; about as fast)."""
         import av
 
         path = Path(path)
@@ -152,13 +170,13 @@ class VideoWriter:
         if codec in ("libx264", "h264"):
             # x264 needs even sizes for 4:2:0; callers pass even sizes, we refuse silently odd ones.
             pix_fmt = pix_fmt or "yuv420p"
-            stream.options = {"crf": str(crf), "preset": preset}
+            stream.options = {"crf": str(crf), "preset": preset, **(_x264_repeatable() if repeatable else {})}
         elif codec == "ffv1":
             # (gbrp would be lossless RGB, but FFV1 in the PyAV wheels refuses it; 4:4:4 YUV
             # loses only the rounding of the RGB->YUV conversion.)
             pix_fmt = pix_fmt or "yuv444p"
-        if threads:
-            stream.codec_context.thread_count = int(threads)
+        if repeatable:
+            stream.codec_context.thread_count = 1
         stream.width, stream.height = int(width), int(height)
         stream.pix_fmt = pix_fmt or "yuv420p"
         if stream.pix_fmt.startswith("yuv"):
