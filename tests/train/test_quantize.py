@@ -32,7 +32,8 @@ def _reference(path, x):
     return ort.InferenceSession(str(path), o, providers=["CPUExecutionProvider"]).run(None, {"x": x})[0]
 
 
-def test_requantize_7bit_bounds_weights_keeps_fusion_and_the_function(tmp_path):
+@pytest.mark.parametrize("per_channel", [True, False])
+def test_requantize_7bit_bounds_weights_keeps_fusion_and_the_function(tmp_path, per_channel):
     from onnxruntime.quantization import CalibrationDataReader, QuantFormat, QuantType, quantize_static
 
     rng = np.random.default_rng(0)
@@ -49,17 +50,18 @@ def test_requantize_7bit_bounds_weights_keeps_fusion_and_the_function(tmp_path):
             return None if x is None else {"x": x}
 
     # the old recipe: full 8-bit weights
-    quantize_static(str(fp32), str(q8), Reader(), quant_format=QuantFormat.QDQ, per_channel=True,
+    quantize_static(str(fp32), str(q8), Reader(), quant_format=QuantFormat.QDQ, per_channel=per_channel,
                     activation_type=QuantType.QUInt8, weight_type=QuantType.QInt8)
     with pytest.raises(WallcliError, match="saturate"):
         saturation_margin(onnx.load(str(q8)))
 
     assert requantize_7bit(q8, q7) == 2
-    assert saturation_margin(onnx.load(str(q7))) == MAX_WEIGHT  # each channel's largest weight maps to 64
+    assert saturation_margin(onnx.load(str(q7))) == MAX_WEIGHT  # each scale's largest weight maps to 64
     assert fused_convolutions(q7) == (2, 0)  # biases rescaled with the weights, so still QLinearConv
     x = rng.standard_normal((3, 3, 16, 32)).astype(np.float32)
     sess = ort.InferenceSession(str(q7), providers=["CPUExecutionProvider"])
     y7, y8 = sess.run(None, {"x": x})[0], _reference(q8, x)
     # the same function up to a weight step: within a few per cent of the output's range
     assert np.abs(y7 - y8).max() < 0.05 * np.abs(y8).max()
-    assert np.abs(y7 - _reference(q7, x)).max() <= 1e-5 * np.abs(y8).max() + 1e-6  # fused == its own QDQ graph
+    # fused == its own QDQ graph, up to one output step where float and integer paths round a .5 apart
+    assert np.abs(y7 - _reference(q7, x)).max() <= 0.01 * np.abs(y8).max()

@@ -123,7 +123,7 @@ def train(
         from wallcli.infer.card import sha256_file
 
         init_info = {"name": base.get("name"), "version": base.get("version"), "sha256": sha256_file(init),
-                     "path": str(init)}
+                     "path": str(init.resolve())}
     cfg = TrainConfig(task=task.value, data=list(data), out=out, val=val, val_fraction=val_fraction, epochs=epochs,
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,

@@ -123,7 +123,7 @@ def _x264_repeatable() -> dict[str, str]:
             return {}
     # 'AVX2' is x264's name for everything up to AVX2 (SSE..AVX2, FMA3, BMI); only passed where
     # the CPU has AVX-512, hence AVX2, and never on non-x86 CPUs (where the name is unknown)
-    return {"x264-params": "asm=AVX2"} if cpu.get("AVX512F") and cpu.get("AVX2") else {}
+    return {"x264-params": "asm=AVX2"} if all(cpu.get(k) for k in ("AVX512F", "AVX2", "FMA3")) else {}
 
 
 class VideoWriter:

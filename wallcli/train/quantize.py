@@ -130,23 +130,33 @@ def requantize_7bit(src: Path, dst: Path) -> int:
     made_by = {o: nd for nd in model.graph.node for o in nd.output}
     n = 0
     for conv, w, scale, dq, init in list(_quantized_weights(model)):
-        axis = next((a.i for a in dq.attribute if a.name == "axis"), 1)
-        shape = [1] * w.ndim
-        shape[axis] = -1
+        if scale.ndim == 0:  # one scale for the whole tensor
+            reduce, shape = None, []
+        else:
+            axis = next((a.i for a in dq.attribute if a.name == "axis"), 1)
+            shape = [1] * w.ndim
+            shape[axis] = -1
+            reduce = tuple(i for i in range(w.ndim) if i != axis)
         wf = w.astype(np.float64) * scale.astype(np.float64).reshape(shape)
-        amax = np.abs(wf).max(axis=tuple(i for i in range(w.ndim) if i != axis))
+        amax = np.abs(wf).max(axis=reduce)
         s7 = np.where(amax > 0, amax / MAX_WEIGHT, 1.0)
         w7 = np.clip(np.rint(wf / s7.reshape(shape)), -MAX_WEIGHT, MAX_WEIGHT).astype(np.int8)
         init[dq.input[0]].CopyFrom(numpy_helper.from_array(w7, dq.input[0]))
-        init[dq.input[1]].CopyFrom(numpy_helper.from_array(s7.astype(scale.dtype), dq.input[1]))
+        init[dq.input[1]].CopyFrom(numpy_helper.from_array(np.asarray(s7, scale.dtype), dq.input[1]))
         # The int32 bias is stored in units of input scale x weight scale; onnxruntime fuses the
-        # QDQ pattern into QLinearConv only when that still holds (else the conv runs in float).
+        # QDQ pattern into QLinearConv only when that (nearly) holds, else the conv runs in float.
         bq = made_by.get(conv.input[2]) if len(conv.input) > 2 else None
         if bq is not None and bq.op_type == "DequantizeLinear" and bq.input[0] in init:
-            x_scale = numpy_helper.to_array(init[made_by[conv.input[0]].input[1]]).astype(np.float64)
+            dqx = made_by.get(conv.input[0])
+            if dqx is None or dqx.op_type != "DequantizeLinear" or dqx.input[1] not in init:
+                raise WallcliError(f"convolution {conv.name}: its input is not quantised, so its int32 bias "
+                                   "has no input scale to follow")
+            x_scale = numpy_helper.to_array(init[dqx.input[1]]).astype(np.float64)
             b = numpy_helper.to_array(init[bq.input[0]]).astype(np.float64)
             b = b * numpy_helper.to_array(init[bq.input[1]]).astype(np.float64)
-            bs = (x_scale * s7).astype(np.float32)
+            # the product in float64, rounded once (within an ulp of the float32 product, which
+            # onnxruntime's fusion tolerates; kept so the shipped 0.4.1/0.3.1 come out byte for byte)
+            bs = np.asarray(x_scale * s7, np.float32)
             init[bq.input[0]].CopyFrom(numpy_helper.from_array(
                 np.rint(b / bs.astype(np.float64)).astype(np.int32), bq.input[0]))
             init[bq.input[1]].CopyFrom(numpy_helper.from_array(bs, bq.input[1]))
@@ -171,7 +181,8 @@ def fused_convolutions(path: Path) -> tuple[int, int]:
         o.optimized_model_filepath = str(Path(d) / "optimized.onnx")
         ort.InferenceSession(str(path), o, providers=["CPUExecutionProvider"])
         ops = [n.op_type for n in onnx.load(o.optimized_model_filepath).graph.node]
-    return ops.count("QLinearConv"), ops.count("Conv")
+    # an unfused convolution may come back as Conv, FusedConv or another float variant
+    return ops.count("QLinearConv"), sum(op.endswith("Conv") and op != "QLinearConv" for op in ops)
 
 
 def onnx_probabilities(path: Path, feeds: dict[str, np.ndarray], batch: int = 64) -> np.ndarray:
