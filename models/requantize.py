@@ -23,8 +23,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
@@ -33,7 +31,7 @@ from evaluate import _predict  # noqa: E402
 from wallcli.infer.card import card_path, read_card, sha256_file, write_card  # noqa: E402
 from wallcli.io.writer import atomic_path  # noqa: E402
 from wallcli.train.data import ShardDataset  # noqa: E402
-from wallcli.train.metrics import breakdown  # noqa: E402
+from wallcli.train.export import measured_validation  # noqa: E402
 from wallcli.train.quantize import MAX_WEIGHT, METHOD, fused_convolutions, requantize_7bit, saturation_margin  # noqa: E402
 
 
@@ -78,10 +76,9 @@ def main() -> None:
         write_card(card_path(new), card)
         ds = ShardDataset(a.data, a.task)
         _, probs, labels = _predict(a.task, ds, str(new))
-        v = card["validation"]
-        v.update(breakdown(probs, labels, ds.visibility(), ds.scene_ids()))
-        v["loss"] = float(-np.mean(np.log(np.clip(probs[np.arange(len(labels)), labels], 1e-12, None))))
-        v["measured_on"] = "the shipped int8 graph (7-bit weights), through onnxruntime"
+        v = card["validation"] = measured_validation(
+            card["validation"], probs, {"labels": labels, "visibility": ds.visibility(), "scenes": ds.scene_ids()},
+            "the shipped int8 graph (7-bit weights), through onnxruntime")
         v["source"] = {"dataset": a.data, "recipe": ds.recipes[0], "seed": ds.recipes[0].get("seed"),
                        "note": "simulated with the repeatable encoder (x264 on one thread, without its AVX-512 code): "
                                "the same files on any machine with AVX2"}

@@ -111,7 +111,7 @@ def train(
     check_outputs([out, card_path(out)], force=force)
     init_info = None
     if init is not None:
-        from wallcli.infer.card import read_card
+        from wallcli.infer.card import read_card, sha256_file
 
         if not init.is_file():
             raise UsageError(f"--init model not found: {init}")
@@ -120,7 +120,6 @@ def train(
             raise UsageError(f"--init {init} is a {base.get('task')!r} model, not {task.value!r}")
         if base.get("preprocessing") != prep:
             raise UsageError(f"--init {init} was trained on {base.get('preprocessing')}, this run on {prep}")
-        from wallcli.infer.card import sha256_file
 
         init_info = {"name": base.get("name"), "version": base.get("version"), "sha256": sha256_file(init),
                      "path": str(init.resolve())}

@@ -61,7 +61,7 @@ def check_parity(net: torch.nn.Module, input_names: list[str], path: Path, *, se
     return worst
 
 
-def _measured(validation: dict[str, Any] | None, probs: np.ndarray, evaluation: dict[str, Any],
+def measured_validation(validation: dict[str, Any] | None, probs: np.ndarray, evaluation: dict[str, Any],
               measured_on: str) -> dict[str, Any]:
     """The validation record measured again on the graph that ships, through onnxruntime: accuracy
     with its scene-bootstrap interval, loss, confusion, visible-window and per-SNR figures."""
@@ -139,7 +139,7 @@ def export_model(net: torch.nn.Module, input_names: list[str], out: Path, card_f
             shipped = onnx_probabilities(tmp_onnx, evaluation["feeds"])
             if quant is not None:
                 quant["max_probability_change"] = float(np.abs(shipped - p32).max())
-            card_fields["validation"] = _measured(
+            card_fields["validation"] = measured_validation(
                 card_fields.get("validation"), shipped, evaluation,
                 f"the shipped {'int8' if quant is not None else 'float32'} graph, through onnxruntime")
         card = build_card(input_names=input_names, sha256=sha256_file(tmp_onnx), size_bytes=tmp_onnx.stat().st_size,

@@ -19,6 +19,7 @@ import torch
 from torch import nn
 
 from wallcli.errors import WallcliError
+from wallcli.train.quantize import dequantize
 
 
 def _initializers(model) -> dict[str, np.ndarray]:
@@ -32,17 +33,9 @@ def _value(name: str, init: dict[str, np.ndarray], made_by: dict[str, Any]) -> n
     if name in init:
         return init[name].astype(np.float64)
     node = made_by.get(name)
-    if node is None or node.op_type != "DequantizeLinear" or node.input[0] not in init:
+    if node is None or node.op_type != "DequantizeLinear" or any(i and i not in init for i in node.input):
         raise WallcliError(f"weight {name!r} is neither a constant nor a dequantised constant")
-    q = init[node.input[0]].astype(np.float64)
-    scale = init[node.input[1]].astype(np.float64)
-    zero = init[node.input[2]].astype(np.float64) if len(node.input) > 2 and node.input[2] else np.zeros_like(scale)
-    if scale.ndim:
-        axis = next((a.i for a in node.attribute if a.name == "axis"), 1)
-        shape = [1] * q.ndim
-        shape[axis] = -1
-        scale, zero = scale.reshape(shape), zero.reshape(shape)
-    return (q - zero) * scale
+    return dequantize(node, init)[0]
 
 
 def _module(net: nn.Module, node_name: str) -> tuple[nn.Module, nn.Module | None]:

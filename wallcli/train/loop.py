@@ -161,7 +161,8 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         raise WallcliError(f"{cfg.data} has too few windows to train on ({ds.n})")
 
     net = build(cfg.task)
-    if cfg.init is not None:
+    ckpt_path = cfg.checkpoint_path()
+    if cfg.init is not None and not (cfg.resume and ckpt_path.is_file()):  # a checkpoint replaces these weights
         from wallcli.train.init import init_from_onnx
 
         # 64 training windows set the batch-norm statistics the folded graph no longer has
@@ -173,7 +174,6 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
     opt = torch.optim.RMSprop(net.parameters(), lr=cfg.lr)
     loss_fn = nn.CrossEntropyLoss()
     ident = _identity(cfg, ds)
-    ckpt_path = cfg.checkpoint_path()
     epoch, start_batch, history, step = 0, 0, [], 0
     ema = {k: v.detach().clone() for k, v in net.state_dict().items()} if cfg.ema > 0 else None
     best: dict[str, Any] = {"accuracy": -1.0, "epoch": None, "state": None, "validation": None}

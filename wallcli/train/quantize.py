@@ -87,6 +87,20 @@ def quantize_int8(src: Path, dst: Path, calib: dict[str, np.ndarray], batch: int
     return {"method": METHOD, "calibration_windows": int(n), "float32_nodes": keep, "max_abs_weight": MAX_WEIGHT}
 
 
+def dequantize(dq, arrays: dict[str, np.ndarray]) -> tuple[np.ndarray, int | None]:
+    """The float64 values of a DequantizeLinear node whose inputs are constants in ``arrays``,
+    and its axis (None when one scale covers the whole tensor)."""
+    q = arrays[dq.input[0]].astype(np.float64)
+    scale = arrays[dq.input[1]].astype(np.float64)
+    zero = arrays[dq.input[2]].astype(np.float64) if len(dq.input) > 2 and dq.input[2] else np.zeros_like(scale)
+    if not scale.ndim:
+        return (q - zero) * scale, None
+    axis = next((a.i for a in dq.attribute if a.name == "axis"), 1)
+    shape = [1] * q.ndim
+    shape[axis] = -1
+    return (q - zero.reshape(shape)) * scale.reshape(shape), axis
+
+
 def _quantized_weights(model):
     """(conv node, int8 weights, scales, their DequantizeLinear node, the initializers by name)
     for every convolution whose weights come through a DequantizeLinear of an int8 initializer."""
@@ -130,14 +144,9 @@ def requantize_7bit(src: Path, dst: Path) -> int:
     made_by = {o: nd for nd in model.graph.node for o in nd.output}
     n = 0
     for conv, w, scale, dq, init in list(_quantized_weights(model)):
-        if scale.ndim == 0:  # one scale for the whole tensor
-            reduce, shape = None, []
-        else:
-            axis = next((a.i for a in dq.attribute if a.name == "axis"), 1)
-            shape = [1] * w.ndim
-            shape[axis] = -1
-            reduce = tuple(i for i in range(w.ndim) if i != axis)
-        wf = w.astype(np.float64) * scale.astype(np.float64).reshape(shape)
+        wf, axis = dequantize(dq, {k: numpy_helper.to_array(init[k]) for k in dq.input if k})
+        reduce = None if axis is None else tuple(i for i in range(w.ndim) if i != axis)
+        shape = [] if axis is None else [-1 if i == axis else 1 for i in range(w.ndim)]
         amax = np.abs(wf).max(axis=reduce)
         s7 = np.where(amax > 0, amax / MAX_WEIGHT, 1.0)
         w7 = np.clip(np.rint(wf / s7.reshape(shape)), -MAX_WEIGHT, MAX_WEIGHT).astype(np.int8)
