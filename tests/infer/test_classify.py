@@ -147,5 +147,8 @@ def test_accuracy_note_reads_the_cards_validation():
         "visible": {"min_snr_db": -10.0, "accuracy": 0.881, "accuracy_95ci": [0.827, 0.93]}}}
     note = accuracy_note(card)
     assert note.startswith("m 1.0: right on 88% (95 % CI 83%-93%)") and "64% (95 % CI 57%-72%) of all" in note
+    assert "another set" not in note
+    card["validation"]["other_sets"] = [{"seed": 121, "visible": {"accuracy": 0.768, "accuracy_95ci": [0.679, 0.847]}}]
+    assert "; 77% (95 % CI 68%-85%) of visible windows on another set;" in accuracy_note(card)
     assert accuracy_note({"validation": {"accuracy": 0.9}}) is None  # no visible-window figure: no note
     assert accuracy_note({"validation": None}) is None
