@@ -11,6 +11,8 @@ the visible windows only, so a model card can say not only how often the model i
 where it stops being able to see. The 95 % intervals resample whole scenes (windows of one
 scene share its room, camera and people): see wallcli/train/metrics.py. ``--against OTHER``
 scores a second model on the same windows and prints the paired difference with its interval.
+The per-clip line scores each scene as ``wallcli count``/``activity`` answer for a whole clip (the
+mean of its windows' probabilities): what a user running the command on a clip of ~10 s sees.
 ``--record`` writes the figures into the model card's ``validation.other_sets`` (one entry per
 dataset seed, replaced when measured again): a single validation set of a few hundred scenes
 can be several points on the lucky side, and the card should say so. The card's main figures
@@ -25,7 +27,7 @@ import numpy as np
 
 from wallcli.infer.model import load_model
 from wallcli.train.data import ShardDataset
-from wallcli.train.metrics import VISIBLE_DB, breakdown, paired_difference, visible_mask
+from wallcli.train.metrics import VISIBLE_DB, breakdown, clip_breakdown, paired_difference, visible_mask
 
 
 def _predict(task: str, ds: ShardDataset, model_path: str | None):
@@ -44,7 +46,7 @@ def evaluate(task: str, data: str | list[str], model_path: str | None = None, vi
     model, p, y = _predict(task, ds, model_path)
     vis, scenes = ds.visibility(), ds.scene_ids()
     out = {"task": task, "data": data, "model": model.info(), "classes": model.classes,
-           **breakdown(p, y, vis, scenes, visible_db)}
+           **breakdown(p, y, vis, scenes, visible_db), "per_clip": clip_breakdown(p, y, vis, scenes, visible_db)}
     if against is not None:
         other, q, _ = _predict(task, ds, against)
         a, b = p.argmax(1) == y, q.argmax(1) == y
@@ -119,6 +121,15 @@ def main() -> None:
     for b in r["accuracy_by_snr"]:
         lo, hi = ("-inf" if b["snr_db"][0] is None else b["snr_db"][0]), ("inf" if b["snr_db"][1] is None else b["snr_db"][1])
         print(f"  least visible mover's SNR {lo:>6} .. {hi:<6} dB: {b['accuracy']:.1%} of {b['windows']}")
+
+    c, cv = r["per_clip"], r["per_clip"].get("visible")
+    if c["accuracy"] is not None:
+        lo, hi = c["accuracy_95ci"]
+        line = f"per clip (mean of a scene's windows, as the commands' clip answer): {c['accuracy']:.1%} (95 % CI {lo:.1%}-{hi:.1%}) of {c['clips']} clips"
+        if cv and cv["accuracy"] is not None:
+            lo, hi = cv["accuracy_95ci"]
+            line += f"; {cv['accuracy']:.1%} (95 % CI {lo:.1%}-{hi:.1%}) of the {cv['clips']} whose windows are all visible"
+        print(line)
 
     if "against" in r:
         o = r["against"]

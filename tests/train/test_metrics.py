@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from wallcli.train.data import ShardDataset
-from wallcli.train.metrics import breakdown, scene_bootstrap
+from wallcli.train.metrics import breakdown, clip_breakdown, scene_bootstrap
 
 
 def _onehot(pred, k=3):
@@ -30,6 +30,23 @@ def test_breakdown_splits_visible_windows_and_snr_bands():
 def test_breakdown_without_visibility_reports_plain_accuracy():
     r = breakdown(_onehot([0, 1, 1]), np.array([0, 1, 2]), None, np.array([0, 0, 1]))
     assert r["accuracy"] == 2 / 3 and r["scenes"] == 2 and "visible" not in r
+
+
+def test_clip_breakdown_averages_a_scenes_windows_like_the_commands_clip_answer():
+    scenes = np.array([7, 7, 7, 3, 3, 9, 9, 5, 5])
+    labels = np.array([1, 1, 1, 2, 2, 0, 0, 1, 2])  # scene 5 has two labels: left out
+    probs = np.array([[0.1, 0.8, 0.1], [0.1, 0.2, 0.7], [0.1, 0.6, 0.3],  # mean says 1: right, though one window says 2
+                      [0.1, 0.5, 0.4], [0.1, 0.4, 0.5],  # mean 0.45 / 0.45: a tie goes to the first, 1: wrong
+                      [0.9, 0.1, 0.0], [0.8, 0.1, 0.1],  # right
+                      [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    vis = np.array([5.0, 5.0, -12.0, 3.0, 4.0, np.nan, np.nan, 1.0, 1.0])
+    r = clip_breakdown(probs, labels, vis, scenes)
+    assert r["clips"] == 3 and r["mixed_label_scenes"] == 1 and r["accuracy"] == 2 / 3
+    lo, hi = r["accuracy_95ci"]
+    assert 0.0 <= lo <= 2 / 3 <= hi <= 1.0
+    # scene 7 has a window under -10 dB, so only scenes 3 and 9 are visible clips
+    assert r["visible"]["clips"] == 2 and r["visible"]["accuracy"] == 0.5
+    assert "visible" not in clip_breakdown(probs, labels, None, scenes)
 
 
 def test_scene_bootstrap_widens_when_errors_come_in_scenes():

@@ -103,3 +103,37 @@ def breakdown(probs: np.ndarray, labels: np.ndarray, visibility: np.ndarray | No
                     "confusion_matrix": confusion(labels[vis], pred[vis], k).tolist()},
         "accuracy_by_snr": bands,
     }
+
+
+def clip_breakdown(probs: np.ndarray, labels: np.ndarray, visibility: np.ndarray | None, scenes: np.ndarray,
+                   visible_db: float = VISIBLE_DB) -> dict[str, Any]:
+    """Accuracy per scene, scored the way ``wallcli count``/``activity`` answer for a whole clip:
+    the mean of the scene's window probabilities. A scene is visible when all its windows are.
+
+    Scenes whose windows disagree on the label (none in the simulator's datasets) are left out
+    and counted in ``mixed_label_scenes``; the intervals resample scenes, each one clip.
+    """
+    probs, labels = np.asarray(probs, np.float64), np.asarray(labels, np.int64)
+    uniq, inv = np.unique(scenes, return_inverse=True)
+    n, k = len(uniq), probs.shape[1]
+    mean = np.zeros((n, k))
+    np.add.at(mean, inv, probs)
+    mean /= np.bincount(inv, minlength=n)[:, None]
+    lo = np.full(n, np.iinfo(np.int64).max)
+    hi = np.full(n, np.iinfo(np.int64).min)
+    np.minimum.at(lo, inv, labels)
+    np.maximum.at(hi, inv, labels)
+    keep = lo == hi
+    ok = mean.argmax(1) == lo
+    ids = np.arange(n)
+    out = {"clips": int(keep.sum()), "mixed_label_scenes": int((~keep).sum()),
+           "accuracy": float(ok[keep].mean()) if keep.any() else None,
+           "accuracy_95ci": scene_bootstrap(ok[keep], ids[keep])}
+    if visibility is not None:
+        seen = np.ones(n, bool)
+        np.logical_and.at(seen, inv, visible_mask(visibility, visible_db))
+        sel = keep & seen
+        out["visible"] = {"min_snr_db": visible_db, "clips": int(sel.sum()),
+                          "accuracy": float(ok[sel].mean()) if sel.any() else None,
+                          "accuracy_95ci": scene_bootstrap(ok[sel], ids[sel])}
+    return out
