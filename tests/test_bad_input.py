@@ -131,8 +131,10 @@ def test_debug_env_shows_traceback(tmp_path, run_cli, monkeypatch):
         run_cli("stplot", tmp_path / "nope.mp4", "--json")
 
 
-def test_sigterm_removes_the_temporary_output(tmp_path):
-    # `kill PID` must unwind like Ctrl-C: one error line, and no `.NAME.XXXX.tmp.mp4` left behind.
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGINT"])
+def test_sigterm_removes_the_temporary_output(tmp_path, signame):
+    # `kill PID` must unwind like Ctrl-C: one error line, exit 1 (not death by a signal: see
+    # wallcli.errors.Interrupted), and no `.NAME.XXXX.tmp.mp4` left behind.
     import signal
     import subprocess
     import sys
@@ -146,7 +148,7 @@ def test_sigterm_removes_the_temporary_output(tmp_path):
     while not list(tmp_path.glob(".v.*.tmp.mp4")) and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.05)
     assert list(tmp_path.glob(".v.*.tmp.mp4")), "the temporary output never appeared"
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(getattr(signal, signame))
     stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 1 and stdout == ""
     assert stderr.strip().splitlines() == ["Error: interrupted"]

@@ -90,21 +90,8 @@ def _click_exceptions():
     return Abort, ClickException, Exit, UsageError
 
 
-def _sigterm_interrupts() -> None:
-    # `kill PID` (SIGTERM) must unwind like Ctrl-C, so atomic_path removes its temporary file;
-    # the default action would end the process on the spot and leave `.NAME.XXXX.tmp.EXT` behind.
-    import signal
-    import threading
-
-    def handler(signum, frame):
-        raise KeyboardInterrupt
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, handler)
-
-
 def main(argv: list[str] | None = None) -> None:
-    from wallcli.errors import WallcliError
+    from wallcli.errors import WallcliError, raise_if_interrupted
 
     Abort, ClickException, Exit, ClickUsageError = _click_exceptions()
 
@@ -114,10 +101,13 @@ def main(argv: list[str] | None = None) -> None:
         sys.stderr.write(f"Warning: {message}\n")
 
     warnings.showwarning = _show
-    _sigterm_interrupts()
+    from wallcli.cli import _signals
+
+    _signals.install()
     command = typer.main.get_command(app)
     try:
         rv = command.main(args=argv, prog_name="wallcli", standalone_mode=False)
+        raise_if_interrupted()  # killed, but the exception was swallowed on the way: still exit 1
         # Without standalone mode, click *returns* the code of an Exit it caught (Ctrl-C -> 130);
         # the contract knows 0, 1 and 2 only: an interrupted job is work that failed (1).
         if isinstance(rv, int) and rv:

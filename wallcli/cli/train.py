@@ -129,7 +129,9 @@ def train(
                       min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
                       anneal=anneal, init=init, lr=lr)
 
-    _sigterm_interrupts()
+    from wallcli.cli import _signals
+
+    _signals.install()  # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1)
     with _TrainProgress(console_err) as bar:
         result = run_training(cfg, bar.event)
 
@@ -209,18 +211,6 @@ def _evaluation(result, preprocessing: str) -> dict | None:
         visibility = None
     return {"feeds": {n: normalize_window(vb[n], preprocessing) for n in vds.inputs}, "labels": vb["label"],
             "visibility": visibility, "scenes": vds.scene_ids()[idx]}
-
-
-def _sigterm_interrupts() -> None:
-    """`kill PID` of a background run saves a checkpoint like Ctrl-C does (then exits 1)."""
-    import signal
-    import threading
-
-    def handler(signum, frame):
-        raise KeyboardInterrupt
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, handler)
 
 
 class _TrainProgress:

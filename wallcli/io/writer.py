@@ -9,7 +9,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Iterable, Iterator
 
-from wallcli.errors import WallcliError
+from wallcli.errors import WallcliError, raise_if_interrupted
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -90,6 +90,7 @@ def atomic_paths(paths: Iterable, *, force: bool = False) -> Iterator[list[Path]
             tmps.append(Path(tmp_name))
             os.chmod(tmp_name, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
         yield list(tmps)
+        raise_if_interrupted()  # a `kill` whose exception Python swallowed still places nothing
         for tmp in tmps:
             with open(tmp, "rb+") as fh:
                 os.fsync(fh.fileno())
