@@ -24,7 +24,9 @@ def install() -> None:
         if not (isinstance(info.exc_value, Interrupted) or info.exc_type is Interrupted):
             previous(info)
 
-    sys.unraisablehook = unraisable
+    unraisable.wallcli = True
+    if not getattr(previous, "wallcli", False):  # main() called again in one process: wrap once
+        sys.unraisablehook = unraisable
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, handler)
         # a shell starts background jobs with SIGINT ignored: leave that as it is
