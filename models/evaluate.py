@@ -61,7 +61,6 @@ def record(task: str, data: str, model_path: str | None, result: dict) -> Path:
     from wallcli.infer.card import card_path, read_card, write_card
     from wallcli.infer.model import shipped_model_path
     from wallcli.io.writer import atomic_path
-    from wallcli.train.data import ShardDataset
 
     path = Path(model_path) if model_path else shipped_model_path(task)
     card = read_card(path)

@@ -21,7 +21,7 @@ def install() -> None:
     def unraisable(info):
         # the raise landed in a weakref callback or __del__: Python would print a traceback and
         # carry on; the flag set above ends the command at its next output, or at its end
-        if not (isinstance(info.exc_value, Interrupted) or info.exc_type is Interrupted):
+        if not issubclass(info.exc_type, Interrupted):
             previous(info)
 
     unraisable.wallcli = True

@@ -129,9 +129,8 @@ def train(
                       min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
                       anneal=anneal, init=init, lr=lr)
 
-    from wallcli.cli import _signals
-
-    _signals.install()  # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1)
+    # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1): wallcli.cli._signals,
+    # installed by main(), turns both into wallcli.errors.Interrupted, which run_training catches.
     with _TrainProgress(console_err) as bar:
         result = run_training(cfg, bar.event)
 
