@@ -165,6 +165,14 @@ class RgbProjector:
     """
 
     def __init__(self, roi: Roi, bins: int, vertical: bool = True):
+        import cv2
+
+        # One OpenCV thread: a frame's reductions are too short (~0.1 ms a plane) for OpenCV's
+        # pool to pay for its hand-offs, and the decoder thread already keeps every core busy.
+        # Measured on 1080p H.264, 2 cores: cv2.reduce 0.25 ms a frame on one thread, 0.75 ms on
+        # two; `wallcli count` 15 % and `stplot` 22 % less wall time (bench/RESULTS.md, session 10).
+        # Process-wide, and harmless for the other commands (snr and amplify measured unchanged).
+        cv2.setNumThreads(1)
         self.vertical = bool(vertical)
         self._zeros = np.zeros((int(bins), 3))
         x, y, w, h = roi
