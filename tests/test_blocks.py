@@ -44,3 +44,30 @@ def test_projector_without_vertical_gives_the_same_horizontal_profile():
     h_full, v_full = RgbProjector(roi, 16)(planes)
     h_only, v_none = RgbProjector(roi, 16, vertical=False)(planes)
     assert np.array_equal(h_full, h_only) and np.ptp(v_full) > 0 and not v_none.any()
+
+
+def test_projector_runs_opencv_on_one_thread_and_restores_the_callers_setting(monkeypatch):
+    import cv2
+
+    from wallcli.io.video import Planes
+    from wallcli.signal import blocks
+
+    seen = []
+    reduce = cv2.reduce
+
+    def spy(*args, **kwargs):
+        seen.append(cv2.getNumThreads())
+        return reduce(*args, **kwargs)
+
+    rng = np.random.default_rng(4)
+    planes = Planes(rng.integers(16, 236, (90, 160), dtype=np.uint8), rng.integers(16, 240, (45, 80), dtype=np.uint8),
+                    rng.integers(16, 240, (45, 80), dtype=np.uint8), sub_x=1, sub_y=1)
+    before = cv2.getNumThreads()
+    try:
+        cv2.setNumThreads(3)
+        monkeypatch.setattr(cv2, "reduce", spy)
+        blocks.RgbProjector((0, 0, 160, 90), 16)(planes)
+        assert seen and set(seen) == {1}  # the frame's reductions ran single-threaded
+        assert cv2.getNumThreads() == 3  # and a library caller's choice is back
+    finally:
+        cv2.setNumThreads(before)

@@ -167,12 +167,7 @@ class RgbProjector:
     def __init__(self, roi: Roi, bins: int, vertical: bool = True):
         import cv2
 
-        # One OpenCV thread: a frame's reductions are too short (~0.1 ms a plane) for OpenCV's
-        # pool to pay for its hand-offs, and the decoder thread already keeps every core busy.
-        # Measured on 1080p H.264, 2 cores: cv2.reduce 0.25 ms a frame on one thread, 0.75 ms on
-        # two; `wallcli count` 15 % and `stplot` 22 % less wall time (bench/RESULTS.md, session 10).
-        # Process-wide, and harmless for the other commands (snr and amplify measured unchanged).
-        cv2.setNumThreads(1)
+        self._cv2 = cv2
         self.vertical = bool(vertical)
         self._zeros = np.zeros((int(bins), 3))
         x, y, w, h = roi
@@ -181,6 +176,21 @@ class RgbProjector:
         self._key = None
 
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
+        # One OpenCV thread for these reductions: a plane's column sums (~0.1 ms) are too short
+        # for OpenCV's pool to pay for its hand-offs, and the decoder thread already keeps every
+        # core busy. Measured on 1080p H.264, 2 cores: 0.25 ms a frame on one thread against 0.75
+        # on two (2-3 ms with other work on the cores); `wallcli count` 15 % and `stplot` 22 % less
+        # wall time (bench/RESULTS.md, session 10). Restored after each frame (0.4 us a toggle), so
+        # a program using wallcli as a library keeps its own OpenCV threading.
+        cv2 = self._cv2
+        threads = cv2.getNumThreads()
+        cv2.setNumThreads(1)
+        try:
+            return self._project(planes)
+        finally:
+            cv2.setNumThreads(threads)
+
+    def _project(self, planes) -> tuple[np.ndarray, np.ndarray]:
         key = (planes.u is None, planes.sub_x, planes.sub_y)
         if key != self._key:
             self._key = key
