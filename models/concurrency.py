@@ -20,8 +20,7 @@ from multiprocessing import Pool
 import numpy as np
 
 import wallcli.datagen.clips as clips
-from wallcli.signal.window import WINDOW, resample
-from wallcli.sim.camera import interp_matrix
+from wallcli.signal.window import WINDOW
 
 _last: dict = {}
 _window_snr_db = clips._window_snr_db
@@ -33,12 +32,8 @@ def _with_chunks(chunk: int):
         prof = scene.clean_profiles
         snr = np.full((len(starts), WINDOW // chunk, 2), np.nan)
         if prof and len(prof[0]) > 2:  # per-person profiles exist for scenes with several people
-            def prep(seq):
-                c = np.stack(seq, axis=1)
-                c, _ = resample(c, np.arange(c.shape[1]) / cam.fps, clips.FPS)
-                return np.einsum("bg,gtc->btc", interp_matrix(h.shape[0], c.shape[0]), c)
-
-            people = [prep([p[2][j] for p in prof]) for j in range(len(prof[0][2]))]
+            people = [clips.profile_on_plot([p[2][j] for p in prof], cam.fps, h.shape[0])
+                      for j in range(len(prof[0][2]))]
             for k, s in enumerate(starts):
                 for c in range(WINDOW // chunk):
                     a, b = s + c * chunk, s + (c + 1) * chunk

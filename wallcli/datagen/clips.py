@@ -66,7 +66,6 @@ def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) 
     promised. Returns (all movers together, the least visible mover alone); NaN where nobody
     moves (or in flatland). Lets training and evaluation stratify windows by visibility.
     """
-    from wallcli.signal.window import resample
 
     both = np.full(len(starts), np.nan, np.float32)
     weakest = np.full(len(starts), np.nan, np.float32)
@@ -74,10 +73,8 @@ def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) 
     if not profiles:
         return both, weakest
 
-    def prep(seq):  # (gx, T, 3) per wall column -> (bins, T', 3) at the plot's rate and bins
-        c = np.stack(seq, axis=1)
-        c, _ = resample(c, np.arange(c.shape[1]) / cam.fps, FPS)
-        return np.einsum("bg,gtc->btc", interp_matrix(h.shape[0], c.shape[0]), c)
+    def prep(seq):
+        return profile_on_plot(seq, cam.fps, h.shape[0])
 
     clean = prep([p[0] for p in profiles])
     if not np.any(clean):  # nobody in the scene
@@ -91,6 +88,16 @@ def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) 
         each, total = _fit_snr_db(x, [c[:, s : s + WINDOW] for c in people])
         both[k], weakest[k] = total, each.min()
     return both, weakest
+
+
+def profile_on_plot(seq: list[np.ndarray], fps: float, bins: int) -> np.ndarray:
+    """Per-frame (gx, 3) noise-free profiles of the wall columns -> (bins, T', 3), at the plot's
+    rate (FPS) and bins, so they can be fitted to the recorded plot."""
+    from wallcli.signal.window import resample
+
+    c = np.stack(seq, axis=1)
+    c, _ = resample(c, np.arange(c.shape[1]) / fps, FPS)
+    return np.einsum("bg,gtc->btc", interp_matrix(bins, c.shape[0]), c)
 
 
 def _fit_snr_db(x: np.ndarray, signals: list[np.ndarray]) -> tuple[np.ndarray, float]:
