@@ -1,7 +1,7 @@
 """Is the seed count net's max over time what keeps it from telling one person from two?
 
     .venv/bin/python models/capacity.py train seed|flat|both DATA OUT.pt --epochs 6
-    .venv/bin/python models/capacity.py eval VAL A.pt B.pt
+    .venv/bin/python models/capacity.py eval VAL A.pt B.pt [C.pt ...] [--mean]
 
 A control experiment, not a shippable model (seed notes §2 fix the head). ``seed`` is the
 seed's CountNet; ``flat`` keeps its five conv blocks but replaces the max over the 13 time
@@ -12,7 +12,7 @@ net sees the room's height as well as its width (a shadow cast by a second lamp 
 height than a second person's). All train with
 the shipped recipe's settings (RMSProp 1e-3, ``--min-snr-db -10``, ``--superpose 0.25``,
 augmentation, weight average; 2 % of DATA held out for the per-epoch line; one thread each, so
-two runs share a 2-core machine) and are scored in float32 on VAL. ``eval`` prints each one's
+two runs share a 2-core machine; ``--threads`` for a run alone) and are scored in float32 on VAL. ``eval`` prints each one's
 accuracy, visible-window accuracy, confusion and per-SNR figures, and the paired difference
 (first minus second) on the visible windows with its scene-bootstrap interval; ``--mean`` also
 scores the models' averaged probabilities (an ensemble) against the first model. Checkpoints
