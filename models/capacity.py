@@ -53,14 +53,18 @@ class TwoPlotCountNet(ActivityNet):
         self.head[-1] = nn.Linear(32, 3)
 
 
-def make(kind: str) -> nn.Module:
+def use_inputs(kind: str) -> None:
     # the data loader gathers the plots the task lists; "both" needs the vertical one too
     TASK_INPUTS["count"] = ["horizontal", "vertical"] if kind == "both" else ["horizontal"]
+
+
+def make(kind: str) -> nn.Module:
+    use_inputs(kind)
     return {"flat": FlatCountNet, "both": TwoPlotCountNet}.get(kind, CountNet)()
 
 
 def train(kind: str, data: str, out: str, epochs: int, threads: int) -> None:
-    make(kind)
+    use_inputs(kind)  # before loop.train opens the data set
     loop.build = lambda task: make(kind)
     cfg = loop.TrainConfig(task="count", data=data, out=out, val_fraction=0.02, epochs=epochs, threads=threads,
                            min_snr_db=-10.0, superpose=0.25, select="last", checkpoint=out + ".ckpt")

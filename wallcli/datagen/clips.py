@@ -66,7 +66,6 @@ def _window_snr_db(scene, cam, h: np.ndarray, t: np.ndarray, starts: list[int]) 
     promised. Returns (all movers together, the least visible mover alone); NaN where nobody
     moves (or in flatland). Lets training and evaluation stratify windows by visibility.
     """
-
     both = np.full(len(starts), np.nan, np.float32)
     weakest = np.full(len(starts), np.nan, np.float32)
     profiles = getattr(scene, "clean_profiles", None)
