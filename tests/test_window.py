@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2, normalize_window
+from wallcli.signal.window import (NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2, NORMALIZATION_V3, normalize_window,
+                                   window_signal_db)
 
 
 def _window(strong: float, faint: float, sigma: float = 1.0, seed: int = 0) -> np.ndarray:
@@ -18,13 +19,14 @@ def _window(strong: float, faint: float, sigma: float = 1.0, seed: int = 0) -> n
 @pytest.mark.parametrize("prep", list(NORMALIZATION_TEXT))
 def test_layout_and_scale_invariance(prep):
     x = _window(50.0, 3.0)
-    y = normalize_window(x, prep)
+    zero = np.zeros((64, 3), np.float32)  # the windows carry their level themselves
+    y = normalize_window(x, prep, zero)
     assert y.shape == (3, 64, 256) and y.dtype == np.float32
     if prep == NORMALIZATION:  # (asinh of a zero-mean signal need not be zero-mean)
         assert np.allclose(y.mean(axis=-1), 0.0, atol=1e-3) and np.isclose(np.sqrt(np.mean(y**2)), 1.0, atol=1e-3)
     # exposure or gain scale every value alike: the input must not change
-    assert np.allclose(normalize_window(7.0 * (x - 120.0) + 30.0, prep), y, atol=1e-3)
-    batch = normalize_window(np.stack([x, _window(0.0, 0.0, seed=1)]), prep)
+    assert np.allclose(normalize_window(7.0 * (x - 120.0) + 30.0, prep, zero), y, atol=1e-3)
+    batch = normalize_window(np.stack([x, _window(0.0, 0.0, seed=1)]), prep, np.stack([zero, zero]))
     assert batch.shape == (2, 3, 64, 256) and np.allclose(batch[0], y, atol=1e-6)
 
 
@@ -55,3 +57,41 @@ def test_v2_survives_a_window_without_frame_noise():
     x[5] = np.linspace(0, 1, 256)[:, None]  # a smooth ramp, no noise at all
     assert np.all(np.isfinite(normalize_window(x, NORMALIZATION_V2)))
     assert np.all(normalize_window(np.zeros((64, 256, 3), np.float32), NORMALIZATION_V2) == 0)
+
+
+def _lit_wall(flicker: float, person: float, seed: int = 0):
+    """(window relative to its first sample's level, that level): a wall with a level profile
+    (vignetting, a lamp's gradient) whose whole light flickers, plus a person's moving shadow."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(256) / 30.0
+    level = (80 + 60 * np.exp(-((np.arange(64) - 25) / 30.0) ** 2))[:, None] * np.array([1.0, 0.9, 0.7])
+    gain = 1 + flicker * np.sin(2 * np.pi * 2.0 * t)  # mains flicker aliased to 2 Hz
+    raw = level[:, None, :] * gain[None, :, None] + rng.normal(0, 0.3, (64, 256, 3))
+    centre = 10 + 40 * t / t[-1]
+    raw -= person * np.exp(-((np.arange(64)[:, None] - centre[None]) / 5.0) ** 2)[..., None]
+    off = raw[:, 0, :].copy()
+    return (raw - off[:, None, :]).astype(np.float32), off.astype(np.float32)
+
+
+def test_v3_removes_a_change_of_the_whole_rooms_light():
+    # 1 % flicker is ~1 code value here, many times the person's 0.3: v1 sees mostly flicker
+    with_flicker, off = _lit_wall(flicker=0.01, person=0.3)
+    without, off0 = _lit_wall(flicker=0.0, person=0.3)
+    a, b = normalize_window(with_flicker, NORMALIZATION_V3, off), normalize_window(without, NORMALIZATION_V3, off0)
+    assert np.corrcoef(a.ravel(), b.ravel())[0, 1] > 0.95
+    v1a, v1b = normalize_window(with_flicker, NORMALIZATION), normalize_window(without, NORMALIZATION)
+    assert np.corrcoef(v1a.ravel(), v1b.ravel())[0, 1] < 0.5
+    # the offset is what v3 needs: without it, a plot could not be told from its light
+    with pytest.raises(ValueError):
+        normalize_window(with_flicker, NORMALIZATION_V3)
+
+
+def test_signal_db_measures_people_not_light_changes():
+    flicker_only, off = _lit_wall(flicker=0.01, person=0.0)
+    person, off_p = _lit_wall(flicker=0.01, person=3.0)
+    quiet = window_signal_db([(flicker_only, off)])
+    loud = window_signal_db([(person, off_p)])
+    assert quiet < -10 and loud > 5
+    # two plots add their powers; a batch gives one figure per window
+    both = window_signal_db([(np.stack([person, flicker_only]), np.stack([off_p, off]))])
+    assert both.shape == (2,) and both[0] > both[1]

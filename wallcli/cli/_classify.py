@@ -72,12 +72,18 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     # one row per window (each lasts window/fps seconds from its start) and the clip's answer;
     # no 'end' column so that five classes fit an 80-column terminal
     classes = result["classes"]
-    rows = [[f"{w['start']:.2f}", w["label"], *(f"{p:.3f}" for p in w["probabilities"])] for w in result["windows"]]
-    rows.append(["clip", result["label"], *(f"{p:.3f}" for p in result["probabilities"])])
+
+    def shown(r):  # an answer that may not be relied upon is not shown as one
+        return str(r["label"]) if r.get("confident", True) else "undetermined"
+
+    rows = [[f"{w['start']:.2f}", shown(w), f"{w.get('signal_db', float('nan')):.0f}", *(f"{p:.3f}" for p in w["probabilities"])]
+            for w in result["windows"]]
+    rows.append(["clip", shown(result), f"{result.get('signal_db', float('nan')):.0f}", *(f"{p:.3f}" for p in result["probabilities"])])
     span = result["window"] / result["fps"]
-    print_table(f"{input}: {task} = {result['label']} (p={max(result['probabilities']):.2f}; "
-                f"{len(result['windows'])} windows of {span:.2f} s)",
-                ["start (s)", "label", *(f"{c} people" if isinstance(c, int) else str(c) for c in classes)], rows)
+    answer = (f"{result['label']} (p={max(result['probabilities']):.2f}" if result.get("confident", True)
+              else f"undetermined ({result.get('reason')}; most likely {result['label']}, p={max(result['probabilities']):.2f}")
+    print_table(f"{input}: {task} = {answer}; {len(result['windows'])} windows of {span:.2f} s)",
+                ["start (s)", "answer", "signal dB", *(f"{c} people" if isinstance(c, int) else str(c) for c in classes)], rows)
     note = accuracy_note(model.card)
     if note:
         from wallcli.cli.output import log

@@ -55,6 +55,9 @@ def train(
                                       "in the card (inference follows the card): v1 = divided by the window's RMS; v2 = "
                                       "in units of the window's frame-to-frame noise, asinh-compressed, so a faint "
                                       "second mover is not scaled away by a strong first (wallcli/signal/window.py)."),
+    arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the seed's nets exactly (count reads the "
+                             "horizontal plot, activity both); 'lite' = both plots for either task, time averaged in "
+                             "pairs and 32 channels (about a quarter of the seed count net's work; wallcli/train/nets.py)."),
     init: Optional[Path] = typer.Option(None, "--init", help="Start from the weights of an exported model of the same "
                                         "task (its .onnx, float or int8): fine-tuning. The card records which."),
     lr: float = typer.Option(1e-3, "--lr", min=1e-7, max=1.0, help="RMSProp learning rate (the seed's 1e-3; "
@@ -102,9 +105,14 @@ def train(
         raise UsageError("--superpose applies to count only (people add up; activities do not)")
     from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2
 
-    versions = {"v1": NORMALIZATION, "v2": NORMALIZATION_V2}
+    from wallcli.signal.window import NORMALIZATION_V3
+    from wallcli.train.nets import ARCHS
+
+    versions = {"v1": NORMALIZATION, "v2": NORMALIZATION_V2, "v3": NORMALIZATION_V3}
     if preprocessing not in versions:
-        raise UsageError(f"--preprocessing must be v1 or v2 (got {preprocessing!r})")
+        raise UsageError(f"--preprocessing must be v1, v2 or v3 (got {preprocessing!r})")
+    if arch not in ARCHS:
+        raise UsageError(f"--arch must be {' or '.join(ARCHS)} (got {arch!r})")
     prep = versions[preprocessing]
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
@@ -127,7 +135,7 @@ def train(
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
                       min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
-                      anneal=anneal, init=init, lr=lr)
+                      anneal=anneal, init=init, lr=lr, arch=arch)
 
     # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1): wallcli.cli._signals,
     # installed by main(), turns both into wallcli.errors.Interrupted, which run_training catches.
@@ -152,7 +160,7 @@ def train(
         preprocessing=prep, normalisation=NORMALIZATION_TEXT[prep],
         training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
-        training={**({"init": init_info} if init_info else {}), "seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
+        training={**({"init": init_info} if init_info else {}), "arch": arch, "seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
                   **({"lr_schedule": f"constant {cfg.lr:g}, then cosine to {cfg.lr * ANNEAL_FLOOR:g} over the last {anneal} epochs"}
                      if anneal else {}),
                   "loss": "cross-entropy", "augmentation": ([SUPERPOSE_DESCRIPTION.format(p=superpose)] if superpose > 0 else [])
@@ -169,7 +177,8 @@ def train(
                              + (f" --anneal {anneal}" if anneal else "")
                              + (f" --lr {lr:g}" if lr != 1e-3 else "")
                              + (f" --init {init}" if init is not None else "")
-                             + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")},
+                             + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")
+                             + (f" --arch {arch}" if arch != "seed" else "")},
         validation=validation,
     )
     quant = _calibration(result, seed, prep) if quantize == "int8" else None
@@ -189,8 +198,10 @@ def _calibration(result, seed: int, preprocessing: str, calib_windows: int = 256
     ds = result["dataset"]
     rng = np.random.default_rng([seed, 0xC0A1])
     tr = np.sort(rng.choice(result["train_indices"], min(calib_windows, len(result["train_indices"])), replace=False))
+    from wallcli.train.data import OFFSETS
+
     b = ds.gather(tr)
-    return {"calib": {n: normalize_window(b[n], preprocessing) for n in ds.inputs}}
+    return {"calib": {n: normalize_window(b[n], preprocessing, b[OFFSETS[n]]) for n in ds.inputs}}
 
 
 def _evaluation(result, preprocessing: str) -> dict | None:
@@ -208,7 +219,9 @@ def _evaluation(result, preprocessing: str) -> dict | None:
         visibility = vds.visibility()[idx]
     except WallcliError:  # a dataset that does not record its movers' SNR: no visible-window figures
         visibility = None
-    return {"feeds": {n: normalize_window(vb[n], preprocessing) for n in vds.inputs}, "labels": vb["label"],
+    from wallcli.train.data import OFFSETS
+
+    return {"feeds": {n: normalize_window(vb[n], preprocessing, vb[OFFSETS[n]]) for n in vds.inputs}, "labels": vb["label"],
             "visibility": visibility, "scenes": vds.scene_ids()[idx]}
 
 

@@ -23,7 +23,10 @@ WINDOW, FPS, BINS = 256, 30.0, 64
 # patch, where their light change stands above a camera's noise (the seed's experiments put people
 # 1.75-3.95 m away); 'anywhere': 1-5 m, roaming 2.5 m, as `simulate` videos do (many such windows
 # carry no detectable signal, which only teaches a model to guess).
-PLACEMENTS = {"visible": {"distance": (0.8, 4.0), "roam": 1.5}, "anywhere": {"distance": (1.0, 5.0), "roam": 2.5}}
+PLACEMENTS = {"visible": {"distance": (0.8, 4.0), "roam": 1.5}, "anywhere": {"distance": (1.0, 5.0), "roam": 2.5},
+              # 'wide': 1-5 m, roaming 2 m, as people are in rooms; windows where they cannot be
+              # seen are measured (snr_db) and left out of training by --min-snr-db
+              "wide": {"distance": (1.0, 5.0), "roam": 2.0}}
 # Class mixes. Count: the task counts people who *move*; someone standing still sways a centimetre,
 # far under any camera's noise, so a standing person in a count scene would be label noise. Count
 # scenes hold movers only, each drawing an activity independently (walking most often: it is the
@@ -31,8 +34,17 @@ PLACEMENTS = {"visible": {"distance": (0.8, 4.0), "roam": 1.5}, "anywhere": {"di
 COUNT_ACTS = (["walking", "crouching", "waving", "jumping"], [0.46, 0.18, 0.18, 0.18])
 
 
-def scene_plan(rng: np.random.Generator, task: str) -> tuple[int, list[str], int]:
-    """(people, activities, label) for one scene, balanced over the task's classes."""
+def scene_plan(rng: np.random.Generator, task: str, domain: str = "base") -> tuple[int, list[str], int]:
+    """(people, activities, label) for one scene, balanced over the task's classes.
+
+    The 'wide' domain's count scenes serve both tasks: movers' activities are balanced, and a
+    third of the empty rooms hold someone standing still (label 0: count counts movers), whose
+    sway can be visible."""
+    if task == "count" and domain == "wide":
+        n = int(rng.integers(0, 3))
+        if n == 0:
+            return (1, ["none"], 0) if rng.random() < 0.35 else (0, [], 0)
+        return n, [str(rng.choice(COUNT_ACTS[0])) for _ in range(n)], n
     if task == "count":
         n = int(rng.integers(0, 3))
         acts = [str(rng.choice(COUNT_ACTS[0], p=COUNT_ACTS[1])) for _ in range(n)]
@@ -125,7 +137,7 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
     from wallcli.signal.window import resample
 
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), int(index), 7]))
-    people, acts, label = scene_plan(rng, task)
+    people, acts, label = scene_plan(rng, task, domain)
     if world == "mixed":
         world = "flatland" if (task == "count" and rng.random() < 0.25) else "room"
     duration = WINDOW / FPS + rng.uniform(1.5, 6.0)
@@ -172,5 +184,9 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         "activity": np.full(len(starts), activity, np.int64),
         "snr_db": snr,
         "snr_db_weakest": snr_weakest,
+        # the clip's mean raw level per position and colour (the plot is that mean removed): what
+        # normalisation v3 needs to tell a whole-wall light change from a person
+        "h_offset": np.repeat(plot.h_mean[None].astype(np.float32), len(starts), axis=0),
+        "v_offset": np.repeat(plot.v_mean[None].astype(np.float32), len(starts), axis=0),
         "scenes": [dict(meta, window_start_s=round(s / FPS, 3)) for s in starts],
     }

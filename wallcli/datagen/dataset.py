@@ -22,7 +22,7 @@ from wallcli.sim.motion import ACTIVITIES
 FORMAT, VERSION = "wallcli.dataset", 1
 SHARD_FORMAT = "wallcli.dataset-shard"
 CLASSES = {"count": [0, 1, 2], "activity": list(ACTIVITIES)}
-ARRAYS = ("horizontal", "vertical", "label", "people", "activity", "snr_db", "snr_db_weakest")
+ARRAYS = ("horizontal", "vertical", "label", "people", "activity", "snr_db", "snr_db_weakest", "h_offset", "v_offset")
 
 
 def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible") -> dict:

@@ -17,7 +17,8 @@ from typing import Any, Iterator
 import numpy as np
 
 from wallcli.errors import WallcliError
-from wallcli.signal.window import StreamWindower, resample, window_starts
+from wallcli.infer.confidence import judge
+from wallcli.signal.window import StreamWindower, resample, window_signal_db, window_starts
 
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
 
@@ -28,10 +29,12 @@ def _too_short(source: str, frames: int, model) -> WallcliError:
         f"one window needs {model.window} frames ({model.window / model.fps:.2f} s)")
 
 
-def _window_record(model, start: float, probs: np.ndarray) -> dict[str, Any]:
+def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> dict[str, Any]:
     k = int(np.argmax(probs))
+    confident, reason = judge(model.card.get("confidence"), probs, signal_db, model.classes)
     return {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
-            "label": model.classes[k], "probabilities": [float(p) for p in probs]}
+            "label": model.classes[k], "probabilities": [float(p) for p in probs],
+            "confident": confident, "reason": reason, "signal_db": round(float(signal_db), 2)}
 
 
 def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
@@ -45,10 +48,13 @@ def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
     return out, grid
 
 
-def _result(model, times, probs, *, stride: int, source: str) -> dict[str, Any]:
-    """The CONTRACT.md result from window start times and their probabilities (n, classes)."""
+def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict[str, Any]:
+    """The CONTRACT.md result from window start times, their probabilities (n, classes) and
+    measured signals (n,) in dB."""
     clip = probs.mean(axis=0)
     clip = clip / clip.sum()
+    clip_db = float(np.mean(signal_db))
+    confident, reason = judge(model.card.get("confidence"), clip, clip_db, model.classes)
     return {
         "input": source,
         "task": model.task,
@@ -57,33 +63,42 @@ def _result(model, times, probs, *, stride: int, source: str) -> dict[str, Any]:
         "classes": model.classes,
         "label": model.classes[int(np.argmax(clip))],
         "probabilities": [float(p) for p in clip],
+        "confident": confident,
+        "reason": reason,
+        "signal_db": round(clip_db, 2),
         "stride": int(stride),
         "window": model.window,
-        "windows": [_window_record(model, t, pr) for t, pr in zip(times, probs)],
+        "windows": [_window_record(model, t, pr, db) for t, pr, db in zip(times, probs, signal_db)],
     }
 
 
 def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
     """The CONTRACT.md result for a whole space-time plot (a .npz file, already in memory)."""
     plots, grid = resampled_plots(model, plot)
+    # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
+    offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     frames = len(grid) if plot.frames >= 2 else plot.frames
     starts = window_starts(frames, model.window, stride)
     if not starts:
         raise _too_short(source, frames, model)
-    probs = []
+    probs, signal = [], []
     for i in range(0, len(starts), CHUNK):
         chunk = starts[i:i + CHUNK]
-        feed = {name: model.normalize(np.stack([p[:, s:s + model.window] for s in chunk]))
-                for name, p in plots.items()}
-        probs.append(model.predict(feed))
-    return _result(model, [grid[s] for s in starts], np.concatenate(probs), stride=stride, source=source)
+        wins = {name: np.stack([p[:, s:s + model.window] for s in chunk]) for name, p in plots.items()}
+        probs.append(model.predict({name: model.normalize(w, offsets[name][None]) for name, w in wins.items()}))
+        signal.append(window_signal_db([(w, offsets[name][None]) for name, w in wins.items()]))
+    return _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
+                   stride=stride, source=source)
 
 
-def _predict_window(model, win: np.ndarray) -> np.ndarray:
-    """Probabilities of one (2*bins, window, 3) window, horizontal rows first."""
+def _predict_window(model, win: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, float]:
+    """(probabilities, signal dB) of one (2*bins, window, 3) window, horizontal rows first; ``ref``
+    (2*bins, 3) is the level the stream's rows are relative to (RowStream.ref)."""
     b = model.bins
     parts = {"horizontal": win[:b], "vertical": win[b:]}
-    return model.predict({n: model.normalize(parts[n][None]) for n in model.input_names})[0]
+    refs = {"horizontal": ref[None, :b], "vertical": ref[None, b:]}
+    probs = model.predict({n: model.normalize(parts[n][None], refs[n]) for n in model.input_names})[0]
+    return probs, float(window_signal_db([(parts[n][None], refs[n]) for n in model.input_names])[0])
 
 
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
@@ -100,7 +115,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
 
     windower = StreamWindower(model.window, stride)
     thumb = PlotThumbnail() if keep_plot else None
-    times, probs, emitted = [], [], 0  # emitted: rows seen when the newest window was classified
+    times, probs, signal, emitted = [], [], [], 0  # emitted: rows seen when the newest window was classified
     with open_video(source, threads=threads) as reader:
         rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, progress=progress,
                          vertical=keep_plot or "vertical" in model.input_names)
@@ -110,15 +125,19 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             done = windower.push(t, row)
             if done is not None:
                 times.append(done[0])
-                probs.append(_predict_window(model, done[2]))
+                p, db = _predict_window(model, done[2], rows.ref)
+                probs.append(p)
+                signal.append(db)
                 emitted = windower.count
     last = windower.last()
     if last is None:
         raise _too_short(str(source), windower.count, model)
     if emitted != windower.count:  # window_starts' end-aligned window: the last `window` rows
         times.append(last[0])
-        probs.append(_predict_window(model, last[2]))
-    result = _result(model, times, np.stack(probs), stride=stride, source=str(source))
+        p, db = _predict_window(model, last[2], rows.ref)
+        probs.append(p)
+        signal.append(db)
+    result = _result(model, times, np.stack(probs), np.asarray(signal), stride=stride, source=str(source))
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
@@ -168,10 +187,10 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> It
 
     windower = StreamWindower(model.window, stride)
     with open_video(source, threads=threads) as reader:
-        for t, row in RowStream(reader, roi=roi, bins=model.bins, fps=model.fps,
-                                vertical="vertical" in model.input_names):
+        rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, vertical="vertical" in model.input_names)
+        for t, row in rows:
             done = windower.push(t, row)
             if done is not None:
-                yield _window_record(model, done[0], _predict_window(model, done[2]))
+                yield _window_record(model, done[0], *_predict_window(model, done[2], rows.ref))
     if windower.count < model.window:
         raise _too_short(str(source), windower.count, model)

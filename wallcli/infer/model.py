@@ -81,11 +81,12 @@ class Model:
     def fps(self) -> float:
         return float(self.card["fps"])
 
-    def normalize(self, windows: np.ndarray) -> np.ndarray:
-        """Raw plot windows (..., bins, window, 3) -> this model's input, as its card says."""
+    def normalize(self, windows: np.ndarray, offset: np.ndarray | None = None) -> np.ndarray:
+        """Raw plot windows (..., bins, window, 3) -> this model's input, as its card says.
+        ``offset`` (..., bins, 3): the level subtracted from the windows (normalize_window)."""
         from wallcli.signal.window import normalize_window
 
-        return normalize_window(windows, self.card["preprocessing"])
+        return normalize_window(windows, self.card["preprocessing"], offset)
 
     def info(self) -> dict[str, str]:
         return {"name": self.card["name"], "version": self.card["version"], "sha256": self.card["sha256"]}

@@ -32,13 +32,19 @@ BINS = 64
 DEFAULT_STRIDE = 64
 NORMALIZATION = "wallcli.signal.window.normalize_window v1"  # the default, and what older cards say
 NORMALIZATION_V2 = "wallcli.signal.window.normalize_window v2"
+NORMALIZATION_V3 = "wallcli.signal.window.normalize_window v3"
 NORMALIZATION_TEXT = {
     NORMALIZATION: "per (bin, colour) temporal mean over the window removed, then divided by the window's "
                    "global RMS; channels first (N, 3, bins, time)",
     NORMALIZATION_V2: "per (bin, colour) temporal mean over the window removed, divided by the window's "
                       "frame-to-frame noise sigma (sigma^2 = half the mean square of the differences between "
                       "consecutive samples, over all bins and colours), then asinh; channels first (N, 3, bins, time)",
+    NORMALIZATION_V3: "per (bin, colour) temporal mean over the window removed; then, per sample and colour, the "
+                      "whole-wall light change (the least-squares fit of a constant plus the wall's mean level profile "
+                      "over the bins) removed; then divided by the window's global RMS; channels first (N, 3, bins, time)",
 }
+# what each version needs besides the window: v3 needs the raw level the window is relative to
+NEEDS_OFFSET = {NORMALIZATION_V3}
 
 
 def resample(plot: np.ndarray, time: np.ndarray, fps: float = CANONICAL_FPS) -> tuple[np.ndarray, np.ndarray]:
@@ -66,12 +72,16 @@ def window_starts(length: int, window: int = WINDOW, stride: int = DEFAULT_STRID
     return starts
 
 
-def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION) -> np.ndarray:
+def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION, offset: np.ndarray | None = None) -> np.ndarray:
     """(..., bins, WINDOW, 3) plot windows -> float32 (..., 3, bins, WINDOW) network input.
 
     ``preprocessing``: a model card's ``preprocessing`` (one of NORMALIZATION_TEXT's keys).
+    ``offset`` (..., bins, 3): what was subtracted from the raw levels to give ``x`` (a plot's
+    clip mean, a stream's first row); v3 needs it, the others ignore it.
     """
     axes = (-3, -2, -1)
+    if preprocessing == NORMALIZATION_V3:
+        return _normalize_v3(x, offset)
     if preprocessing == NORMALIZATION:
         # kept operation for operation as the shipped models were trained and their goldens recorded
         # (v2's faster channels-first order would move int8 inputs across quantisation steps)
@@ -93,6 +103,66 @@ def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION) -> np.nd
     # asinh as log(|z| + sqrt(z^2 + 1)): numpy's float32 arcsinh is twice as slow; same to 3e-7
     a = np.abs(x)
     return np.copysign(np.log(a + np.sqrt(a * a + 1.0)), x).astype(np.float32, copy=False)
+
+
+def _normalize_v3(x: np.ndarray, offset: np.ndarray | None) -> np.ndarray:
+    """v3: v1 after removing, per sample and colour, the part of the profile that a change of the
+    whole room's light explains.
+
+    Mains flicker aliased to the frame rate, daylight drift and exposure steps multiply the whole
+    wall's light: each sample's profile moves by a multiple of the wall's mean level profile
+    (plus an offset for the camera's black level and tone curve). A person changes the light
+    unevenly along the wall. Projecting every sample onto the complement of span{1, level}
+    removes the first exactly, whatever its waveform, and keeps what differs from place to place,
+    so no rule about frequencies or amplitudes is needed to tell flicker from a person. The price:
+    a person so far away that the whole wall brightens evenly is removed too, as it cannot be
+    told from a light change.
+    """
+    x = remove_light_changes(x, offset)
+    rms = np.sqrt(np.mean(np.square(x), axis=(-3, -2, -1), keepdims=True))
+    x = (x / np.maximum(rms, 1e-8)).astype(np.float32)
+    return np.ascontiguousarray(np.moveaxis(x, -1, -3))
+
+
+def remove_light_changes(x: np.ndarray, offset: np.ndarray | None) -> np.ndarray:
+    """(..., bins, T, 3) windows relative to ``offset`` (..., bins, 3) -> float64 windows with each
+    (bin, colour)'s temporal mean and, per sample and colour, the whole-wall light change removed
+    (the projection of normalisation v3, before its scaling)."""
+    x = np.asarray(x, np.float32)
+    if offset is None:
+        raise ValueError("normalisation v3 needs the windows' level offset")
+    mean = x.mean(axis=-2, keepdims=True)  # (..., bins, 1, 3)
+    level = (np.asarray(offset, np.float32)[..., None, :] + mean).astype(np.float64)  # raw mean level
+    x = (x - mean).astype(np.float64)
+    bins = x.shape[-3]
+    u = np.full((bins, 1, 1), 1.0 / np.sqrt(bins))
+    lc = level - level.mean(axis=-3, keepdims=True)
+    norm = np.sqrt(np.sum(lc * lc, axis=-3, keepdims=True))
+    # a flat wall (or a plot without its level) has no level direction beyond the constant
+    lc = np.where(norm > 1e-6 * np.maximum(np.abs(level).mean(axis=-3, keepdims=True), 1e-9), lc / np.maximum(norm, 1e-30), 0.0)
+    return x - u * np.sum(x * u, axis=-3, keepdims=True) - lc * np.sum(x * lc, axis=-3, keepdims=True)
+
+
+SIGNAL_FLOOR_DB = -30.0
+
+
+def window_signal_db(parts: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """How strong the signal of plot windows is, in dB over their noise, after the whole-wall
+    light changes are removed (seed notes section 4, on the plots).
+
+    ``parts``: [(windows (..., bins, T, 3), offsets (..., bins, 3))], e.g. the horizontal and the
+    vertical plot. Noise power = half the mean square of the differences between consecutive
+    samples; signal power = total power minus noise. Floored at SIGNAL_FLOOR_DB (a window of
+    pure noise measures about 0 signal, whose ratio is meaningless).
+    """
+    total = noise = 0.0
+    for x, off in parts:
+        y = remove_light_changes(x, off)
+        total = total + np.mean(np.square(y), axis=(-3, -2, -1))
+        noise = noise + 0.5 * np.mean(np.square(np.diff(y, axis=-2)), axis=(-3, -2, -1))
+    sig = np.asarray(total - noise, np.float64)
+    ratio = sig / np.maximum(np.asarray(noise, np.float64), 1e-30)
+    return np.maximum(10 * np.log10(np.maximum(ratio, 1e-30)), SIGNAL_FLOOR_DB)
 
 
 class StreamResampler:

@@ -66,10 +66,10 @@ def _colour(rng, lo: float, hi: float) -> np.ndarray:
 
 
 def sample_person(rng: np.random.Generator, domain: str = "base") -> Person:
-    shifted = domain == "shifted"
-    height = rng.uniform(1.25, 2.0) if shifted else rng.uniform(1.5, 1.95)
-    girth = rng.uniform(0.8, 1.35) if shifted else rng.uniform(0.85, 1.2)
-    lo, hi = (0.02, 0.5) if shifted else (0.03, 0.85)
+    shifted, wide = domain == "shifted", domain == "wide"
+    height = rng.uniform(1.25, 2.0) if (shifted or wide) else rng.uniform(1.5, 1.95)
+    girth = rng.uniform(0.8, 1.35) if (shifted or wide) else rng.uniform(0.85, 1.2)
+    lo, hi = (0.02, 0.5) if shifted else ((0.02, 0.85) if wide else (0.03, 0.85))
     skin = np.clip(rng.uniform(0.12, 0.6) * np.array([1.0, 0.75, 0.6]), 0.02, 0.9)
     return Person(height, girth, _colour(rng, lo, hi), _colour(rng, lo, hi), skin, bool(rng.random() < 0.6))
 

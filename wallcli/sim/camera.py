@@ -53,6 +53,8 @@ class CameraParams:
 
 def sample_camera(rng: np.random.Generator, domain: str = "base", *, nuisance_p: float = 0.35) -> CameraParams:
     """Random camera: from very clean (large ROI, low gain) to very noisy (small ROI, high ISO)."""
+    if domain == "wide":
+        return _sample_wide_camera(rng)
     shifted = domain == "shifted"
     w = int(rng.choice([128, 144, 160, 176, 192]) if not shifted else rng.choice([96, 112, 208, 224]))
     h = int(2 * round(w * rng.uniform(0.56, 0.8) / 2))
@@ -75,6 +77,36 @@ def sample_camera(rng: np.random.Generator, domain: str = "base", *, nuisance_p:
     if rng.random() < nuisance_p:
         p.drift = rng.uniform(0.0, 0.01)
         p.flicker = rng.uniform(0.0, 0.004) * (rng.random() < 0.5)
+        p.mains = float(rng.choice([50.0, 60.0]))
+        p.ae_steps = int(rng.integers(0, 3))
+        p.ae_size = rng.uniform(0.005, 0.03)
+        p.shake = rng.uniform(0.0, 0.3) * (rng.random() < 0.5)
+    return p
+
+
+def _sample_wide_camera(rng) -> CameraParams:
+    """The 'wide' domain's camera: the union of the base and shifted ranges, small frames too, and
+    lighting nuisances (drift, aliased mains flicker of up to 1 %, exposure steps) in half the clips:
+    real rooms change their whole light while nobody moves, and a model must not count that."""
+    w = int(rng.choice([96, 112, 128, 144, 160, 192, 224]))
+    h = int(2 * round(w * rng.uniform(0.56, 0.8) / 2))
+    p = CameraParams(width=w, height=max(h, 64))
+    p.fps = float(rng.choice([15, 20, 24, 25, 29.97, 30, 30, 48, 50, 60]))
+    p.level = rng.uniform(40, 210)
+    p.gain = float(np.exp(rng.uniform(np.log(0.01), np.log(1.5))))
+    p.read_noise = rng.uniform(0.3, 3.0)
+    p.sensor_pixels = float(np.exp(rng.uniform(np.log(3e4), np.log(2e6))))
+    p.prnu = rng.uniform(0.002, 0.03)
+    p.texture = rng.uniform(0.005, 0.05)
+    p.vignette = rng.uniform(0.0, 0.5)
+    p.gamma = float(rng.uniform(1.6, 2.4)) if rng.random() < 0.6 else 0.0
+    if rng.random() < 0.55:
+        # crf 0 is lossless H.264, which some recorders write
+        p.codec, p.crf = "libx264", (0 if rng.random() < 0.2 else int(rng.integers(6, 26)))
+    p.chroma = "420" if rng.random() < 0.6 else "444"
+    if rng.random() < 0.5:
+        p.drift = rng.uniform(0.0, 0.015)
+        p.flicker = rng.uniform(0.0, 0.01) * (rng.random() < 0.6)
         p.mains = float(rng.choice([50.0, 60.0]))
         p.ae_steps = int(rng.integers(0, 3))
         p.ae_size = rng.uniform(0.005, 0.03)

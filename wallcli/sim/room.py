@@ -104,14 +104,46 @@ def _paint(rng, lo: float, hi: float, tint: float) -> np.ndarray:
 
 
 def sample_room(rng: np.random.Generator, domain: str = "base") -> Room:
-    """A random furnished box room. ``domain='shifted'`` moves every range (held-out validation)."""
+    """A random furnished box room. ``domain='shifted'`` moves every range (held-out validation);
+    ``domain='wide'`` spans both and lights rooms the ways rooms are lit (``_wide_lighting``)."""
+    if domain == "wide":
+        return _sample_room(rng, "wide", rng.uniform(3.0, 9.0), rng.uniform(4.5, 10.0), rng.uniform(2.4, 3.8))
     shifted = domain == "shifted"
     W = rng.uniform(5.5, 9.0) if shifted else rng.uniform(3.0, 7.0)
     D = rng.uniform(6.0, 9.5) if shifted else rng.uniform(4.5, 8.0)
     H = rng.uniform(2.9, 3.8) if shifted else rng.uniform(2.4, 3.1)
+    return _sample_room(rng, domain, W, D, H)
+
+
+# How a room is lit, for the 'wide' domain: daylight through a window in a side or back wall,
+# ceiling panels (large area lights overhead), both, a few lamps, or any mix. The base and shifted
+# domains light rooms with small lamps and wall windows only, and their models never saw an
+# overhead area light or a room lit by one window alone.
+WIDE_LIGHTING = ("window_side", "window_back", "ceiling", "ceiling_window", "lamps", "mixed")
+
+
+def _wide_lighting(rng) -> tuple[int, list[int]]:
+    """(number of lamps, surfaces of the area lights) for one 'wide' room."""
+    kind = WIDE_LIGHTING[int(rng.integers(0, len(WIDE_LIGHTING)))]
+    if kind == "window_side":
+        return int(rng.random() < 0.3), [int(rng.integers(0, 2))] * int(rng.integers(1, 3))
+    if kind == "window_back":
+        return int(rng.random() < 0.3), [2] * int(rng.integers(1, 3))
+    if kind == "ceiling":
+        return 0, [4] * int(rng.integers(1, 5))
+    if kind == "ceiling_window":
+        return 0, [4] * int(rng.integers(1, 4)) + [int(rng.integers(0, 3))]
+    if kind == "lamps":
+        return int(rng.integers(1, 5)), []
+    return int(rng.integers(0, 4)), [int(rng.choice([0, 1, 2, 4])) for _ in range(int(rng.integers(1, 4)))]
+
+
+def _sample_room(rng, domain, W, D, H) -> Room:
+    shifted = domain == "shifted"
+    wide = domain == "wide"
     size = np.array([W, D, H])
     albedo = np.empty((5, TEX, TEX, 3))
-    wall_paint = _paint(rng, 0.25, 0.6, 0.25) if shifted else _paint(rng, 0.4, 0.9, 0.15)
+    wall_paint = _paint(rng, 0.25, 0.6, 0.25) if shifted else (_paint(rng, 0.25, 0.9, 0.25) if wide else _paint(rng, 0.4, 0.9, 0.15))
     for s in range(5):
         paint = wall_paint if s < 3 else (_paint(rng, 0.1, 0.5, 0.3) if s == 3 else _paint(rng, 0.6, 0.9, 0.05))
         if s < 3 and rng.random() < 0.3:
@@ -127,10 +159,15 @@ def sample_room(rng: np.random.Generator, domain: str = "base") -> Room:
             albedo[s, iv[0] : iv[1], iu[0] : iu[1]] = _paint(rng, 0.03, 0.8, 0.6)
     albedo = np.clip(albedo, 0.02, 0.95)
 
-    n_lamps = int(rng.integers(0, 5 if shifted else 4))
-    n_windows = int(rng.integers(0, 3))
-    if n_lamps + n_windows == 0:
-        n_lamps = 1
+    if wide:
+        n_lamps, area_lights = _wide_lighting(rng)
+        n_windows = len(area_lights)
+    else:
+        n_lamps = int(rng.integers(0, 5 if shifted else 4))
+        n_windows = int(rng.integers(0, 3))
+        area_lights = None
+        if n_lamps + n_windows == 0:
+            n_lamps = 1
     lamp_pos, lamp_radius, lamp_rad = [], [], []
     for _ in range(n_lamps):
         kind = rng.random()
@@ -150,7 +187,7 @@ def sample_room(rng: np.random.Generator, domain: str = "base") -> Room:
                 pos[1] = D - rng.uniform(0.15, 0.35)
         temp = rng.uniform(0, 1)  # warm .. cool white
         colour = np.array([1.0, 0.72 + 0.25 * temp, 0.45 + 0.55 * temp]) * (1 + rng.uniform(-0.05, 0.05, 3))
-        intensity = rng.uniform(15, 300) * (0.5 if shifted else 1.0)
+        intensity = rng.uniform(15, 300) * (0.5 if shifted else 1.0) * (np.exp(rng.uniform(-1.2, 0.3)) if wide else 1.0)
         lamp_pos.append(pos)
         lamp_radius.append(a)
         lamp_rad.append(colour * intensity / (np.pi * a * a))
@@ -173,11 +210,17 @@ def sample_room(rng: np.random.Generator, domain: str = "base") -> Room:
     sky = np.array([0.85, 0.93, 1.0]) * (1 + rng.uniform(-0.08, 0.08, 3))
     window_mask = np.zeros((5, TEX, TEX), bool)
     window_rad = np.zeros((5, TEX, TEX, 3))
-    for _ in range(n_windows):
-        s = int(rng.integers(0, 3))
-        wu, wv = rng.uniform(0.15, 0.45), rng.uniform(0.3, 0.55)
-        u0, v0 = rng.uniform(0.05, 0.95 - wu), rng.uniform(0.25, 0.95 - wv)
-        L = rng.uniform(3, 60) * sky
+    for j in range(n_windows):
+        s = int(rng.integers(0, 3)) if area_lights is None else area_lights[j]
+        if s == 4:  # a ceiling panel: anywhere overhead, warm to cool white, as bright as a window
+            wu, wv = rng.uniform(0.08, 0.35), rng.uniform(0.08, 0.35)
+            u0, v0 = rng.uniform(0.02, 0.98 - wu), rng.uniform(0.02, 0.98 - wv)
+            temp = rng.uniform(0, 1)
+            L = rng.uniform(5, 80) * np.array([1.0, 0.8 + 0.18 * temp, 0.6 + 0.4 * temp])
+        else:
+            wu, wv = rng.uniform(0.15, 0.45), rng.uniform(0.3, 0.55)
+            u0, v0 = rng.uniform(0.05, 0.95 - wu), rng.uniform(0.25, 0.95 - wv)
+            L = rng.uniform(3, 60) * sky
         iu = slice(int(u0 * TEX), int((u0 + wu) * TEX))
         iv = slice(int(v0 * TEX), int((v0 + wv) * TEX))
         grad = 1 + rng.uniform(-0.2, 0.2) * (vv[iv, iu] - v0) / wv

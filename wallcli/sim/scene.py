@@ -147,7 +147,7 @@ class Scene:
 
 def _region(rng, size, domain):
     W, D, H = size
-    w = min(rng.uniform(0.6, 4.0) if domain == "shifted" else rng.uniform(0.8, 3.0), W - 0.4)
+    w = min(rng.uniform(0.6, 4.0) if domain in ("shifted", "wide") else rng.uniform(0.8, 3.0), W - 0.4)
     h = min(w * rng.uniform(0.55, 0.85), H - 0.3)
     lo = 0.2 + w / 2
     xc = rng.uniform(lo, max(lo, W - 0.2 - w / 2))  # equal bounds (a wall-wide region) may round to hi < lo

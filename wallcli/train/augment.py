@@ -108,11 +108,18 @@ def augment(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Gene
     ramp = np.linspace(-1.0, 1.0, t, dtype=np.float32)
     for name in inputs:
         x = batch[name].astype(np.float32, copy=True)
+        key = {"horizontal": "h_offset", "vertical": "v_offset"}[name]
+        off = batch[key].astype(np.float32, copy=True) if key in batch else None
         if name == "horizontal":
             x[mirror] = x[mirror, ::-1]
+            if off is not None:
+                off[mirror] = off[mirror, ::-1]
         x[reverse] = x[reverse, :, ::-1]
         x = np.take_along_axis(x, perms[:, None, None, :], axis=3)
         x *= gains
+        if off is not None:  # the level moves with its window: same mirror, colours and gains
+            off = np.take_along_axis(off, perms[:, None, :], axis=2) * gains[:, 0]
+            out[key] = off
         rms = window_rms(x)
         x += (rng.standard_normal(x.shape, dtype=np.float32)
               * (noise_rel * rms).astype(np.float32)[:, None, None, None])

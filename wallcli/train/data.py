@@ -22,9 +22,12 @@ DATASET_FORMAT = "wallcli.dataset"
 SHARD_FORMAT = "wallcli.dataset-shard"
 
 
+OFFSETS = {"horizontal": "h_offset", "vertical": "v_offset"}
+
+
 class ShardDataset:
     def __init__(self, root: Path | str | list, task: str, *, bins: int = 64, window: int = 256,
-                 buffer_windows: int = 2048) -> None:
+                 buffer_windows: int = 2048, inputs: list[str] | tuple[str, ...] | None = None) -> None:
         # several folders (e.g. two simulator runs with different seeds) act as one dataset
         roots = [Path(r) for r in root] if isinstance(root, (list, tuple)) else [Path(root)]
         if not roots:
@@ -33,7 +36,10 @@ class ShardDataset:
         self.manifests = [self._manifest(r, task, bins, window) for r in roots]
         self.manifest: dict[str, Any] = self.manifests[0]
         self.task = task
-        self.inputs = TASK_INPUTS[task]
+        # an activity net may learn from a count dataset of the 'wide' domain, whose scenes hold
+        # movers of every activity: its windows with at most one mover, labelled by their activity
+        self.relabel = [m.get("task") == "count" and task == "activity" for m in self.manifests]
+        self.inputs = list(inputs) if inputs else TASK_INPUTS[task]
         self.classes = TASK_CLASSES[task]
         self.shape = (bins, window, 3)
         self.files = [r / s["file"] for r, m in zip(roots, self.manifests) for s in m["shards"]]
@@ -61,6 +67,9 @@ class ShardDataset:
         if man.get("complete") is False:
             raise WallcliError(f"{root} is still being written (dataset.json says complete: false)",
                                hint="finish it by re-running the same dataset command")
+        wide = (man.get("recipe") or {}).get("domain") == "wide"
+        if man.get("task") == "count" and task == "activity" and wide:
+            return man
         if man.get("task") != task:
             raise WallcliError(f"{root} is a {man.get('task')!r} dataset, training a {task!r} model needs a {task!r} one")
         if list(man.get("classes", [])) != TASK_CLASSES[task]:
@@ -88,6 +97,13 @@ class ShardDataset:
             if name not in arrays:
                 raise WallcliError(f"{self.files[i]}: missing array {name!r}")
             out[name] = arrays[name]
+        if self._relabelled(i):
+            out["label"] = arrays["activity"]
+        for name in self.inputs:
+            # the level each window is relative to (normalisation v3); zeros for older shards
+            key = OFFSETS[name]
+            out[key] = (arrays[key].astype(np.float32) if key in arrays
+                        else np.zeros((n, self.shape[0], self.shape[2]), np.float32))
         for name in self.inputs:
             if out[name].shape != (n, *self.shape):
                 raise WallcliError(f"{self.files[i]}: {name!r} has shape {out[name].shape}, "
@@ -105,10 +121,36 @@ class ShardDataset:
             self._cache_windows -= len(old["label"])
         return out
 
+    def _relabelled(self, shard: int) -> bool:
+        k = int(np.searchsorted(np.cumsum([len(m["shards"]) for m in self.manifests]), shard, side="right"))
+        return self.relabel[k]
+
+    def usable(self, indices: np.ndarray) -> np.ndarray:
+        """``indices`` without windows this task cannot use: from a relabelled count dataset,
+        those with two movers (an activity net answers for one person)."""
+        import zipfile
+
+        indices = np.asarray(indices, dtype=np.int64)
+        if not any(self.relabel):
+            return indices
+        keep = np.ones(self.n, bool)
+        for i, f in enumerate(self.files):
+            if not self._relabelled(i):
+                continue
+            try:
+                with np.load(f, allow_pickle=False) as npz:
+                    keep[self.offsets[i]:self.offsets[i + 1]] = npz["label"] <= 1
+            except (OSError, ValueError, KeyError, zipfile.BadZipFile) as e:
+                raise WallcliError(f"{f} is not a readable shard ({e})") from None
+        return indices[keep[indices]]
+
     def gather(self, idx: np.ndarray) -> dict[str, np.ndarray]:
-        """Raw windows (len(idx), bins, window, 3) per input, plus 'label', in the order of idx."""
+        """Raw windows (len(idx), bins, window, 3) per input, their level offsets (OFFSETS: (len(idx),
+        bins, 3)), plus 'label', in the order of idx."""
         shard = np.searchsorted(self.offsets, idx, side="right") - 1
         out = {name: np.empty((len(idx), *self.shape), np.float32) for name in self.inputs}
+        for name in self.inputs:
+            out[OFFSETS[name]] = np.empty((len(idx), self.shape[0], self.shape[2]), np.float32)
         out["label"] = np.empty(len(idx), np.int64)
         for s in np.unique(shard):
             sel = np.nonzero(shard == s)[0]

@@ -33,7 +33,7 @@ from wallcli.errors import WallcliError
 from wallcli.infer.card import sha256_file
 from wallcli.signal.window import NORMALIZATION
 from wallcli.train.augment import augment, superpose
-from wallcli.train.data import ShardDataset, split_validation
+from wallcli.train.data import OFFSETS, ShardDataset, split_validation
 from wallcli.train.nets import build
 
 CKPT_FORMAT = "wallcli.train-checkpoint"
@@ -81,15 +81,17 @@ class TrainConfig:
     superpose: float = 0.0  # count: fraction of windows summed with another (augment.superpose)
     preprocessing: str = NORMALIZATION  # which normalize_window the net is trained on (the card records it)
     init: Path | None = None  # an exported model (.onnx) whose weights training starts from
+    arch: str = "seed"  # wallcli.train.nets.ARCHS
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
 
 
-def _to_tensor(x: np.ndarray, channels_last: bool, preprocessing: str = NORMALIZATION) -> torch.Tensor:
+def _to_tensor(x: np.ndarray, channels_last: bool, preprocessing: str = NORMALIZATION,
+               offset: np.ndarray | None = None) -> torch.Tensor:
     from wallcli.signal.window import normalize_window
 
-    t = torch.from_numpy(np.ascontiguousarray(normalize_window(x, preprocessing), dtype=np.float32))
+    t = torch.from_numpy(np.ascontiguousarray(normalize_window(x, preprocessing, offset), dtype=np.float32))
     return t.contiguous(memory_format=torch.channels_last) if channels_last else t
 
 
@@ -104,7 +106,7 @@ def evaluate(net: nn.Module, ds: ShardDataset, indices: np.ndarray, batch_size: 
     with torch.no_grad():
         for idx in ds.plan(indices, batch_size, np.random.default_rng(0), shuffle=False):
             b = ds.gather(idx)
-            logits = net(*[_to_tensor(b[n], channels_last, preprocessing) for n in ds.inputs])
+            logits = net(*[_to_tensor(b[n], channels_last, preprocessing, b.get(OFFSETS[n])) for n in ds.inputs])
             y = torch.from_numpy(b["label"])
             loss_sum += float(nn.functional.cross_entropy(logits, y, reduction="sum"))
             np.add.at(cm, (b["label"], logits.argmax(1).numpy()), 1)
@@ -139,6 +141,7 @@ def _identity(cfg: TrainConfig, ds: ShardDataset) -> dict[str, Any]:
     return {"task": cfg.task, "windows": ds.n, "dataset_seed": [m.get("seed") for m in ds.manifests], "ema": cfg.ema,
             "superpose": cfg.superpose, "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None,
             **({} if cfg.preprocessing == NORMALIZATION else {"preprocessing": cfg.preprocessing}),
+            **({} if cfg.arch == "seed" else {"arch": cfg.arch}),
             **({} if cfg.init is None else {"init": sha256_file(Path(cfg.init))}),
             **({} if cfg.lr == 1e-3 else {"lr": cfg.lr})}
 
@@ -149,18 +152,20 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
     if cfg.threads > 0:
         torch.set_num_threads(cfg.threads)
     torch.manual_seed(cfg.seed)
-    ds = ShardDataset(cfg.data, cfg.task, buffer_windows=cfg.buffer_windows)
+    inputs = list(build(cfg.task, cfg.arch).input_names)
+    ds = ShardDataset(cfg.data, cfg.task, buffer_windows=cfg.buffer_windows, inputs=inputs)
     if cfg.val is not None:
-        val_ds = ShardDataset(cfg.val, cfg.task, buffer_windows=cfg.buffer_windows)
-        train_idx, val_idx = np.arange(ds.n), np.arange(val_ds.n)
+        val_ds = ShardDataset(cfg.val, cfg.task, buffer_windows=cfg.buffer_windows, inputs=inputs)
+        train_idx, val_idx = np.arange(ds.n), val_ds.usable(np.arange(val_ds.n))
     else:
         val_ds = ds
         train_idx, val_idx = split_validation(ds.n, cfg.val_fraction, cfg.seed)
-    train_idx = ds.visible(train_idx, cfg.min_snr_db)
+        val_idx = ds.usable(val_idx)
+    train_idx = ds.visible(ds.usable(train_idx), cfg.min_snr_db)
     if len(train_idx) < 2:
         raise WallcliError(f"{cfg.data} has too few windows to train on ({ds.n})")
 
-    net = build(cfg.task)
+    net = build(cfg.task, cfg.arch)
     ckpt_path = cfg.checkpoint_path()
     if cfg.init is not None and not (cfg.resume and ckpt_path.is_file()):  # a checkpoint replaces these weights
         from wallcli.train.init import init_from_onnx
@@ -168,7 +173,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         # 64 training windows set the batch-norm statistics the folded graph no longer has
         pick = np.sort(np.random.default_rng([cfg.seed, 0x1417]).choice(train_idx, min(64, len(train_idx)), replace=False))
         b = ds.gather(pick)
-        init_from_onnx(net, cfg.init, [_to_tensor(b[n], False, cfg.preprocessing) for n in ds.inputs])
+        init_from_onnx(net, cfg.init, [_to_tensor(b[n], False, cfg.preprocessing, b.get(OFFSETS[n])) for n in ds.inputs])
     if cfg.channels_last:
         net = net.to(memory_format=torch.channels_last)
     opt = torch.optim.RMSprop(net.parameters(), lr=cfg.lr)
@@ -216,7 +221,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
                     b = superpose(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0x5AB]), cfg.superpose)
                 if cfg.augment:
                     b = augment(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0xA06]))
-                xs = [_to_tensor(b[n], cfg.channels_last, cfg.preprocessing) for n in ds.inputs]
+                xs = [_to_tensor(b[n], cfg.channels_last, cfg.preprocessing, b.get(OFFSETS[n])) for n in ds.inputs]
                 y = torch.from_numpy(b["label"])
                 for g in opt.param_groups:
                     g["lr"] = learning_rate(cfg, epoch, bi, len(batches))

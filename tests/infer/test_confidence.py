@@ -1,0 +1,63 @@
+"""Decided or undetermined: thresholds fitted on validation windows, and how answers are judged."""
+import numpy as np
+
+from wallcli.infer.confidence import NO_BLOCK_REASON, fit, judge, validate_block
+
+CLASSES = [0, 1, 2]
+
+
+def _validation(seed=0, n=6000):
+    """Windows whose answers are right more often the higher their probability, and never right
+    in the faintest band when they say 0 (a person the model cannot see reads as nobody)."""
+    rng = np.random.default_rng(seed)
+    truth = rng.integers(0, 3, n)
+    snr = rng.uniform(-25, 20, n)
+    pmax = rng.uniform(0.34, 1.0, n)
+    right = rng.random(n) < pmax ** 0.3  # confident answers are right more often
+    pred = np.where(right, truth, (truth + rng.integers(1, 3, n)) % 3)
+    faint = snr < -10
+    pred[faint] = 0
+    truth[faint] = 1
+    probs = np.full((n, 3), 0.0)
+    probs[np.arange(n), pred] = pmax
+    for i in range(n):
+        others = [c for c in range(3) if c != pred[i]]
+        probs[i, others] = (1 - pmax[i]) / 2
+    return probs, truth, snr
+
+
+def test_fitted_thresholds_meet_the_level_where_they_exist():
+    probs, truth, snr = _validation()
+    block = fit(probs, truth, snr, CLASSES, level=0.95, edges=[-10.0, 0.0, 10.0])
+    assert validate_block(block, 3) is None
+    assert block["thresholds"][0][0] is None  # the faint band's 'nobody' is never right: never decided
+    decided = np.array([judge(block, p, s, CLASSES)[0] for p, s in zip(probs, snr)])
+    right = probs.argmax(1) == truth
+    assert decided.mean() > 0.2
+    assert right[decided].mean() >= 0.95  # in-sample, the level holds by construction
+    # on fresh windows from the same process it holds within sampling error
+    p2, t2, s2 = _validation(seed=1)
+    d2 = np.array([judge(block, p, s, CLASSES)[0] for p, s in zip(p2, s2)])
+    assert (p2.argmax(1) == t2)[d2].mean() > 0.92
+
+
+def test_judge_gives_a_reason_whenever_it_does_not_decide():
+    probs, truth, snr = _validation()
+    block = fit(probs, truth, snr, CLASSES, level=0.95, edges=[-10.0, 0.0, 10.0])
+    ok, reason = judge(block, [0.9, 0.05, 0.05], -20.0, CLASSES)
+    assert not ok and "never 95% right" in reason and "'0 people'" in reason
+    t = block["thresholds"][3][1]
+    assert judge(block, [0.0, t, 1 - t], 15.0, CLASSES)[0] is False or t >= 0.5
+    ok, reason = judge(block, [0.01, 0.98, 0.01], 15.0, CLASSES)
+    assert ok and reason is None
+    ok, reason = judge(None, [0.01, 0.98, 0.01], 15.0, CLASSES)
+    assert not ok and reason == NO_BLOCK_REASON
+
+
+def test_a_malformed_block_is_named():
+    probs, truth, snr = _validation()
+    block = fit(probs, truth, snr, CLASSES, level=0.95, edges=[-10.0, 0.0, 10.0])
+    assert "level" in validate_block({**block, "level": 2}, 3)
+    assert "signal_edges_db" in validate_block({**block, "signal_edges_db": [3, 1, 2]}, 3)
+    assert "one row per signal band" in validate_block({**block, "thresholds": block["thresholds"][:2]}, 3)
+    assert "one entry per class" in validate_block(block, 5)

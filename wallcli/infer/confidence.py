@@ -1,0 +1,117 @@
+"""Decided or undetermined: when an answer may be relied upon, from the model's own validation.
+
+A model card's ``confidence`` block holds, per answer (class) and per band of measured signal
+(``window_signal_db``: the plot's power over its frame-to-frame noise, whole-wall light changes
+removed), the smallest probability at which that answer was right at least ``level`` of the time
+on a validation set the model never trained on. An answer is confident when its probability
+reaches the threshold of its class in its signal band; otherwise it is *undetermined*, with a
+one-line reason. ``label`` and ``probabilities`` keep their meaning either way.
+
+Why per class and per band: a probability means different things in different places. Where
+the signal is at the noise, "nobody" is what the model says of an empty room and of a person it
+cannot see, and only validation data with both can say how often it is right; a strong signal
+with a "two people" answer fails in other ways. Thresholds are fitted on simulated validation
+windows only (never on the clips a model is judged on), with a floor on the windows behind each
+one, so that a cell too thin to measure stays undetermined rather than guessed.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+FORMAT = "wallcli.confidence v1"
+MIN_SUPPORT = 25  # validation windows a threshold must rest on
+NO_BLOCK_REASON = "the model card states no validated confidence thresholds"
+
+
+def band_of(edges: list[float], snr_db: float) -> int:
+    return int(np.searchsorted(np.asarray(edges, float), float(snr_db), side="right"))
+
+
+def _band_text(edges: list[float], b: int) -> str:
+    lo = f"{edges[b - 1]:g}" if b > 0 else None
+    hi = f"{edges[b]:g}" if b < len(edges) else None
+    if lo is None:
+        return f"under {hi} dB"
+    if hi is None:
+        return f"{lo} dB and over"
+    return f"{lo} to {hi} dB"
+
+
+def fit(probs: np.ndarray, labels: np.ndarray, snr_db: np.ndarray, classes: list[Any], *, level: float,
+        edges: list[float], min_support: int = MIN_SUPPORT) -> dict[str, Any]:
+    """The card's confidence block from validation windows: (n, k) probabilities, true class
+    indices, measured signal (dB). For each (band, answer) the smallest threshold t such that the
+    windows answered so with p >= t are right >= ``level`` of the time and number >= min_support;
+    None where no such t exists."""
+    probs = np.asarray(probs, np.float64)
+    labels = np.asarray(labels, np.int64)
+    pred = probs.argmax(1)
+    pmax = probs.max(1)
+    bands = np.array([band_of(edges, s) for s in snr_db])
+    table = []
+    for b in range(len(edges) + 1):
+        row = []
+        for c in range(len(classes)):
+            sel = (bands == b) & (pred == c)
+            p, ok = pmax[sel], (labels[sel] == c)
+            order = np.argsort(-p)
+            p, ok = p[order], ok[order]
+            # precision of the top-m answers for every m; the threshold is the lowest p whose
+            # top set still meets the level (and every larger set of them does not need to)
+            hits = np.cumsum(ok)
+            m = np.arange(1, len(p) + 1)
+            good = (hits / m >= level) & (m >= min_support)
+            if not good.any():
+                row.append(None)
+                continue
+            j = int(np.flatnonzero(good).max())
+            row.append(round(float(p[j]), 4))
+        table.append(row)
+    return {"format": FORMAT, "level": level, "signal_edges_db": list(edges), "thresholds": table,
+            "min_support": min_support,
+            "thresholds_axes": "rows: signal bands (under the first edge, between edges, over the last); columns: "
+                               "answers in the order of classes; null: never right that often"}
+
+
+def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]) -> tuple[bool, str | None]:
+    """(confident, reason) for one answer (its probabilities and measured signal)."""
+    if not block:
+        return False, NO_BLOCK_REASON
+    probs = np.asarray(probs, np.float64)
+    k = int(probs.argmax())
+    edges = block["signal_edges_db"]
+    b = band_of(edges, snr_db)
+    t = block["thresholds"][b][k]
+    level = block["level"]
+    label = classes[k]
+    what = f"{label} people" if isinstance(label, int) else str(label)
+    if t is None:
+        return False, (f"at {snr_db:.0f} dB of signal ({_band_text(edges, b)}) the model was never {level:.0%} "
+                       f"right when it answered '{what}' in validation")
+    if probs[k] < t:
+        return False, (f"p={probs[k]:.2f} for '{what}' at {snr_db:.0f} dB of signal; the model is {level:.0%} right "
+                       f"there only from p={t:.2f}")
+    return True, None
+
+
+def validate_block(block: Any, n_classes: int) -> str | None:
+    """A message naming what is wrong with a card's confidence block, or None when it is usable."""
+    if not isinstance(block, dict):
+        return "confidence must be an object"
+    level, edges, table = block.get("level"), block.get("signal_edges_db"), block.get("thresholds")
+    if not isinstance(level, (int, float)) or isinstance(level, bool) or not 0 < level <= 1:
+        return "confidence.level must be a number in (0, 1]"
+    if (not isinstance(edges, list) or not all(isinstance(e, (int, float)) and not isinstance(e, bool)
+                                               and np.isfinite(e) for e in edges) or sorted(edges) != edges):
+        return "confidence.signal_edges_db must be an increasing list of finite numbers"
+    if not isinstance(table, list) or len(table) != len(edges) + 1:
+        return "confidence.thresholds must have one row per signal band"
+    for row in table:
+        if not isinstance(row, list) or len(row) != n_classes:
+            return "confidence.thresholds rows must have one entry per class"
+        for t in row:
+            if t is not None and (not isinstance(t, (int, float)) or isinstance(t, bool) or not 0 <= t <= 1):
+                return "confidence.thresholds entries must be null or numbers in [0, 1]"
+    return None

@@ -1,0 +1,69 @@
+"""Fit a model's decided/undetermined thresholds on simulated validation windows; write them in its card.
+
+The exported graph itself (onnxruntime, as users run it) scores every usable window of the
+validation datasets; each window's signal is measured as inference measures it
+(``window_signal_db``); ``wallcli.infer.confidence.fit`` turns both into the card's
+``confidence`` block. The .onnx file is untouched (the card's sha256 covers only it), and the
+card is rewritten atomically.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wallcli.infer.card import card_path, read_card
+from wallcli.infer.confidence import fit
+from wallcli.signal.window import window_signal_db
+
+DEFAULT_EDGES = [-10.0, 0.0, 10.0]
+
+
+def score_dataset(model_path: Path, data: list[Path], *, batch: int = 128) -> dict[str, np.ndarray]:
+    """Probabilities, labels, measured signal and visibility of every usable window of ``data``."""
+    from wallcli.infer.model import Model
+    from wallcli.train.data import OFFSETS, ShardDataset
+
+    model = Model.load(model_path)
+    ds = ShardDataset([Path(d) for d in data], model.task, inputs=model.input_names)
+    idx = ds.usable(np.arange(ds.n))
+    probs, signal, labels = [], [], []
+    for i in range(0, len(idx), batch):
+        b = ds.gather(idx[i:i + batch])
+        probs.append(model.predict({n: model.normalize(b[n], b[OFFSETS[n]]) for n in model.input_names}))
+        signal.append(window_signal_db([(b[n], b[OFFSETS[n]]) for n in model.input_names]))
+        labels.append(b["label"])
+    return {"probs": np.concatenate(probs), "labels": np.concatenate(labels), "signal_db": np.concatenate(signal),
+            "visibility": ds.visibility()[idx], "scenes": ds.scene_ids()[idx], "classes": model.classes}
+
+
+def calibrate(model_path: Path, data: list[Path], *, level: float, edges: list[float] | None = None) -> dict[str, Any]:
+    """Write the ``confidence`` block into the card of ``model_path``; returns the block."""
+    from wallcli.io.writer import write_text_atomic
+
+    edges = list(DEFAULT_EDGES if edges is None else edges)
+    s = score_dataset(model_path, data)
+    block = fit(s["probs"], s["labels"], s["signal_db"], s["classes"], level=level, edges=edges)
+    pred = s["probs"].argmax(1)
+    right = pred == s["labels"]
+    decided = np.array([_decided(block, p, db) for p, db in zip(s["probs"], s["signal_db"])])
+    block["calibrated_on"] = {
+        "datasets": [str(d) for d in data], "windows": int(len(right)),
+        "accuracy": round(float(right.mean()), 4),
+        "coverage": round(float(decided.mean()), 4),
+        "accuracy_decided": round(float(right[decided].mean()), 4) if decided.any() else None,
+        "note": "simulated validation windows the model never trained on; thresholds are fitted here, so "
+                "these in-sample figures are optimistic: see the card's transfer block for held-out ones",
+    }
+    card = read_card(model_path)
+    card["confidence"] = block
+    write_text_atomic(card_path(model_path), json.dumps(card, indent=2) + "\n", force=True)
+    return block
+
+
+def _decided(block, probs, db) -> bool:
+    from wallcli.infer.confidence import judge
+
+    return judge(block, probs, db, list(range(len(probs))))[0]
