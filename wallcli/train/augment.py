@@ -16,6 +16,10 @@ its label, which is how a model trained on the simulator learns to ignore the ro
   darker rooms, stronger compression.
 - slow illumination drift (p 0.3): a ramp common to all positions (daylight, auto exposure),
   up to half the window's RMS.
+- a change of the whole room's light (p 0.4, needs the windows' level offsets): every raw level
+  multiplied by 1 + g(t), g a sinusoid of 0.1-6 Hz (mains flicker aliased to the frame rate,
+  a flickering lamp), a slow drift or an exposure step, of 0.2-3x the window's RMS, the same for
+  all plots. Rooms do this with nobody in them; the label stays.
 
 Count only, optional (``--superpose P``, off by default):
 
@@ -42,6 +46,7 @@ DESCRIPTION = [
     "per-channel gain jitter, log-normal sigma 0.25",
     "added white noise, std log-uniform 2-50% of window RMS (p=0.5)",
     "slow illumination ramp common to all positions, up to 0.5x window RMS (p=0.3)",
+    "whole-room light change x(1+g(t)) on the raw levels: sinusoid 0.1-6 Hz, drift or step, 0.2-3x window RMS (p=0.4)",
 ]
 
 
@@ -125,4 +130,36 @@ def augment(batch: dict[str, np.ndarray], inputs: list[str], rng: np.random.Gene
               * (noise_rel * rms).astype(np.float32)[:, None, None, None])
         x += (drift_rel * rms).astype(np.float32)[:, None, None, None] * ramp[None, None, :, None]
         out[name] = x
+    if all(OFFSET_KEYS[n] in out for n in inputs):
+        _light_change(out, inputs, rng)
     return out
+
+
+OFFSET_KEYS = {"horizontal": "h_offset", "vertical": "v_offset"}
+
+
+def _light_change(out: dict, inputs: list[str], rng: np.random.Generator, p: float = 0.4) -> None:
+    """In place: raw levels (window + offset) of a share ``p`` of windows times 1 + g(t)."""
+    first = out[inputs[0]]
+    b, _, t, _ = first.shape
+    sel = rng.random(b) < p
+    if not sel.any():
+        return
+    tt = np.arange(t, dtype=np.float64) / 30.0
+    g = np.zeros((b, t))
+    kind = rng.integers(0, 3, b)
+    for i in np.flatnonzero(sel):
+        if kind[i] == 0:
+            g[i] = np.sin(2 * np.pi * np.exp(rng.uniform(np.log(0.1), np.log(6.0))) * tt + rng.uniform(0, 2 * np.pi))
+        elif kind[i] == 1:
+            g[i] = sum(np.sin(2 * np.pi * rng.uniform(0.02, 0.3) * tt + rng.uniform(0, 2 * np.pi)) for _ in range(2)) / 2
+        else:
+            g[i] = np.tanh((tt - rng.uniform(0.1, 0.9) * tt[-1]) / rng.uniform(0.05, 0.5))
+        g[i] -= g[i].mean()
+    # amplitude relative to the window's own variation, measured on the first plot
+    level = np.abs(out[OFFSET_KEYS[inputs[0]]] + first.mean(axis=2)).mean(axis=(1, 2)) + 1e-9
+    amp = np.exp(rng.uniform(np.log(0.2), np.log(3.0), b)) * window_rms(first) / level / (np.abs(g).max(axis=1) + 1e-9)
+    g *= (amp * sel)[:, None]
+    for name in inputs:
+        raw = out[name] + out[OFFSET_KEYS[name]][:, :, None, :]
+        out[name] = (out[name] + raw * g[:, None, :, None]).astype(np.float32)
