@@ -174,3 +174,23 @@ def test_bad_labels_and_usage(tmp_path, run_cli):
     assert code == 1 and "running" in err
     code, _, err = run_cli("evaluate", tmp_path, "--task", "age")
     assert code == 2
+
+
+def test_one_decode_per_clip_gives_both_the_answer_and_the_snr(sims, single, monkeypatch):
+    import wallcli.io.video as video
+    from wallcli.evaluate.clip import measure_clip
+    from wallcli.infer.model import load_model
+
+    opened = []
+    real = video.open_video
+    monkeypatch.setattr(video, "open_video", lambda src, **kw: opened.append(src) or real(src, **kw))
+    model = load_model("count")
+    out = measure_clip(model, sims / "walk.mp4", stride=int(model.card["stride"]))
+    assert opened == [str(sims / "walk.mp4")]
+    assert out["result"]["probabilities"] == single["count", "walk.mp4"]["probabilities"]
+    assert out["snr_db"] > -99 and out["snr_block"] == 8
+
+
+def test_an_roi_outside_every_frame_fails_the_run(sims, run_cli):
+    code, out, err = run_cli("evaluate", sims, "--task", "count", "--roi", "0,0,500,500", "--jobs", "1")
+    assert code == 1 and out == "" and "none of the 6 clips" in err and "64x48" in err

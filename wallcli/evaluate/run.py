@@ -60,6 +60,12 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
                 if progress:
                     progress(1)
     rows = [_row(c, outcome[i], task) for i, c in enumerate(kept)]
+    if rows and all(r["error"] is not None for r in rows):
+        # nothing was analysed: a wrong folder, an ROI outside every frame. The work failed.
+        raise WallcliError(f"none of the {len(rows)} clips could be analysed (first, {rows[0]['file']}: "
+                           f"{rows[0]['error']})")
+    if not rows:
+        raise WallcliError(f"{folder}: no clip to score ({len(skipped)} clips of more than one person skipped)")
     return report(rows, task=task, model=model.info(), classes=classes, folder=str(folder), labels=source,
                   skipped=skipped, stride=stride, roi=roi)
 
