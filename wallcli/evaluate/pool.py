@@ -85,6 +85,9 @@ def _run(ctx, fn, items, todo, jobs, began: set, initializer, initargs) -> Itera
                     continue
                 yield futures[f], value
             if broke:
+                for f in pending:  # finished before the break, but not yet collected
+                    if f.done() and not f.cancelled() and f.exception() is None:
+                        yield futures[f], f.result()
                 clean = True  # the executor has already stopped its workers
                 yield None, None
                 return
