@@ -25,7 +25,7 @@ $W simulate --dataset 1024 --task activity -o data/val_activity4 --jobs "$JOBS" 
 
 # Training sets place people where their light reaches the camera above its noise (--placement
 # visible, the default).
-# count 0.4.0 (shipped as 0.4.1: its 8-bit weights rounded to 7 bits by models/requantize.py; this
+# count 0.4.0 (shipped as 0.4.1: its 8-bit weights rounded to 7 bits by research/requantize.py; this
 # command now quantises to 7 bits from float directly): moving people only, a quarter flatland,
 # superposition augmentation
 $W simulate --dataset 8192 --task count -o data/count4 --jobs "$JOBS" --seed 6 --world mixed
@@ -38,7 +38,7 @@ $W simulate --dataset 8192 --task activity -o data/activity3 --jobs "$JOBS" --se
 $W train activity --data data/activity2 --data data/activity3 --val data/val_activity3 --out models/activity.onnx \
   --epochs "$EPOCHS_ACTIVITY" --threads 2 --min-snr-db -10 --select last --quantize int8 --model-version 0.3.0 --force
 
-# The second sets' figures in the cards (models/evaluate.py --record; the model is not touched)
+# The second sets' figures in the cards (research/evaluate.py --record; the model is not touched)
 PY=${PYTHON:-.venv/bin/python}
-$PY models/evaluate.py count data/val_count7 --record
-$PY models/evaluate.py activity data/val_activity4 --record
+$PY research/evaluate.py count data/val_count7 --record
+$PY research/evaluate.py activity data/val_activity4 --record

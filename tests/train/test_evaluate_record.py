@@ -1,4 +1,4 @@
-"""models/evaluate.py --record: a second validation set's figures go into the card, nothing else."""
+"""research/evaluate.py --record: a second validation set's figures go into the card, nothing else."""
 from __future__ import annotations
 
 import importlib.util
@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _evaluate_module():
-    spec = importlib.util.spec_from_file_location("wallcli_models_evaluate", ROOT / "models" / "evaluate.py")
+    spec = importlib.util.spec_from_file_location("wallcli_research_evaluate", ROOT / "research" / "evaluate.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod

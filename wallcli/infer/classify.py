@@ -102,23 +102,24 @@ def _predict_window(model, win: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray
 
 
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
-                   keep_plot: bool = False):
+                   keep_plot: bool = False, taps=()):
     """(result, plot) for a video, decoded once into windows classified as they complete.
 
     Gives the windows of :func:`classify_plot` on the same video (the end-aligned last one
     included), while holding only the last ``model.window`` resampled rows.  ``plot`` (for
     ``--plot``) is None unless ``keep_plot``; then it is a :class:`PlotThumbnail` copy of at most
-    2048 time columns, enough to draw, not the full plot.
+    2048 time columns, enough to draw, not the full plot. ``taps`` (callables) also get every
+    decoded frame (:class:`wallcli.io.video.FrameTee`), e.g. to measure the SNR in the same decode.
     """
-    from wallcli.io.video import open_video
+    from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
 
     windower = StreamWindower(model.window, stride)
     thumb = PlotThumbnail() if keep_plot else None
     times, probs, signal, emitted = [], [], [], 0  # emitted: rows seen when the newest window was classified
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, progress=progress,
-                         vertical=keep_plot or "vertical" in model.input_names)
+        rows = RowStream(FrameTee(reader, taps) if taps else reader, roi=roi, bins=model.bins, fps=model.fps,
+                         progress=progress, vertical=keep_plot or "vertical" in model.input_names)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)

@@ -361,6 +361,26 @@ class VideoReader:
         self.close()
 
 
+class FrameTee:
+    """A reader whose :meth:`frames` also hands every decoded frame to ``taps`` (callables), in
+    order, before yielding it: one decode feeds several consumers (``wallcli evaluate`` reads the
+    classifier's rows and the snr estimator from the same frames). Everything else is the reader's.
+    A tap must not keep the frame's planes past its call: they view the decoder's buffers."""
+
+    def __init__(self, reader: VideoReader, taps) -> None:
+        self.reader = reader
+        self.taps = tuple(taps)
+
+    def __getattr__(self, name: str):
+        return getattr(self.reader, name)
+
+    def frames(self) -> Iterator[Frame]:
+        for frame in self.reader.frames():
+            for tap in self.taps:
+                tap(frame)
+            yield frame
+
+
 class VideoWarning(UserWarning):
     """Recoverable trouble in a video (corrupt packets, truncation); the CLI prints these once."""
 

@@ -316,6 +316,30 @@ class SnrAccumulator:
         return SnrResult(self.frames, self.roi, scales, self.lattice.pixels, self.lattice.exact, list(self.warnings))
 
 
+class FrameSnr:
+    """:class:`SnrAccumulator` fed whole decoded frames, the ROI checked against the first one (as
+    the space-time plots check theirs): a tap for :class:`wallcli.io.video.FrameTee`, so the SNR
+    of a clip comes out of a decode that also feeds something else."""
+
+    def __init__(self, roi: Roi | None = None, *, max_pixels: int = DEFAULT_MAX_PIXELS):
+        self.requested, self.max_pixels = roi, int(max_pixels)
+        self.acc: SnrAccumulator | None = None
+
+    def __call__(self, frame) -> None:
+        planes = frame.planes
+        if self.acc is None:
+            from wallcli.signal.blocks import check_roi
+
+            roi = check_roi(self.requested, planes.width, planes.height)
+            self.acc = SnrAccumulator(roi, max_pixels=self.max_pixels)
+        self.acc.update(planes)
+
+    def result(self) -> SnrResult:
+        if self.acc is None:
+            raise WallcliError("no frame was decoded; the noise estimate needs at least 3")
+        return self.acc.result()
+
+
 # ---------------------------------------------------------------------------------- maps / auto ROI
 def grid_shape(w: int, h: int, long_side: int, fy: int = 1, fx: int = 1) -> tuple[int, int, int, int]:
     """(rows, cols, cell_h, cell_w): about square cells of whole chroma samples, <= long_side per side."""

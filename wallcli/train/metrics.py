@@ -1,6 +1,6 @@
 """How well a model does on a simulator dataset, and how sure we are of it (numpy only).
 
-Used by ``wallcli train`` (the card's validation block) and ``models/evaluate.py``.
+Used by ``wallcli train`` (the card's validation block) and ``research/evaluate.py``.
 
 Two things a bare accuracy hides:
 

@@ -1,6 +1,6 @@
 """Are count's two-person errors windows whose two movers are not seen at the same time?
 
-    .venv/bin/python models/concurrency.py --seed 107 --domain shifted [--scenes 256] [--chunk 64]
+    .venv/bin/python research/concurrency.py --seed 107 --domain shifted [--scenes 256] [--chunk 64]
 
 The seed's count net takes a max over 13 time steps of features with a ~4.5 s receptive field:
 it can only tell two people from one where both show within one such stretch. A window's

@@ -1,6 +1,6 @@
 """Is there anything to find in a window whose mover is under -10 dB? A check without a net.
 
-    .venv/bin/python models/visibility_bound.py data/val_count4 [--task count]
+    .venv/bin/python research/visibility_bound.py data/val_count4 [--task count]
 
 A detector that knows where the people's light lives (the visible windows put 80-90 % of their
 power below ~1 Hz in time and ~3 cycles across the 64 positions, where the camera's white noise

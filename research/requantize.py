@@ -1,8 +1,8 @@
 """Give a shipped 8-bit-weight model 7-bit weights and measure it again (one-off, session 7).
 
-    .venv/bin/python models/requantize.py count data/val_count6 --version 0.4.1
-    .venv/bin/python models/requantize.py activity data/val_activity3 --version 0.3.1
-    .venv/bin/python models/requantize.py count data/val_count6 --remeasure   # new data, same model
+    .venv/bin/python research/requantize.py count data/val_count6 --version 0.4.1
+    .venv/bin/python research/requantize.py activity data/val_activity3 --version 0.3.1
+    .venv/bin/python research/requantize.py count data/val_count6 --remeasure   # new data, same model
 
 Why: onnxruntime's x86 uint8 x int8 kernels without VNNI add pairs of products into a saturating
 int16, so an int8 model with weights up to 127 computes other numbers on an AVX2 CPU than on a
@@ -69,7 +69,7 @@ def main() -> None:
             quant = card["onnx"]["quantization"]
             quant.update(method=METHOD, max_abs_weight=MAX_WEIGHT, largest_weight=worst)
             quant["requantized_from"] = {"version": old["version"], "sha256": old["sha256"],
-                                         "by": "models/requantize.py (7-bit weights from the 8-bit ones)"}
+                                         "by": "research/requantize.py (7-bit weights from the 8-bit ones)"}
             # measured on an 8-bit graph whose answers depended on the CPU; not this graph's
             for k in ("float32_accuracy", "max_probability_change"):
                 quant.pop(k, None)

@@ -1,9 +1,9 @@
 """Score an ONNX model on a simulator dataset through wallcli's run-time path (onnxruntime).
 
-    .venv/bin/python models/evaluate.py count data/val_count [--model models/count.onnx] [--json]
-    .venv/bin/python models/evaluate.py count data/val_count --model new.onnx --against models/count.onnx
-    .venv/bin/python models/evaluate.py count data/val_count7 --record   # into the card's other_sets
-    .venv/bin/python models/evaluate.py count data/val_count6 data/val_count7   # two sets as one
+    .venv/bin/python research/evaluate.py count data/val_count [--model models/count.onnx] [--json]
+    .venv/bin/python research/evaluate.py count data/val_count --model new.onnx --against models/count.onnx
+    .venv/bin/python research/evaluate.py count data/val_count7 --record   # into the card's other_sets
+    .venv/bin/python research/evaluate.py count data/val_count6 data/val_count7   # two sets as one
 
 Prints accuracy, the confusion matrix, per-class recall and accuracy against visibility
 (the movers' SNR per window in the recorded plot, written by the simulator), and the same on
@@ -71,7 +71,7 @@ def record(task: str, data: str, model_path: str | None, result: dict) -> Path:
     entry = {"dataset": data, "seed": seed, "recipe": recipe,
              **{k: result[k] for k in ("windows", "scenes", "accuracy", "accuracy_95ci", "confusion_matrix",
                                        "visible", "accuracy_by_snr") if k in result},
-             "measured_on": "the shipped graph, through onnxruntime (models/evaluate.py --record)"}
+             "measured_on": "the shipped graph, through onnxruntime (research/evaluate.py --record)"}
     v = card.setdefault("validation", {})
     others = [o for o in v.get("other_sets", []) if o.get("seed") != entry["seed"]]
     v["other_sets"] = sorted(others + [entry], key=lambda o: (o.get("seed") is None, o.get("seed")))

@@ -1,7 +1,7 @@
 """Is the seed count net's max over time what keeps it from telling one person from two?
 
-    .venv/bin/python models/capacity.py train seed|flat|both DATA OUT.pt --epochs 6
-    .venv/bin/python models/capacity.py eval VAL A.pt B.pt [C.pt ...] [--mean]
+    .venv/bin/python research/capacity.py train seed|flat|both DATA OUT.pt --epochs 6
+    .venv/bin/python research/capacity.py eval VAL A.pt B.pt [C.pt ...] [--mean]
 
 A control experiment, not a shippable model (seed notes §2 fix the head). ``seed`` is the
 seed's CountNet; ``flat`` keeps its five conv blocks but replaces the max over the 13 time

@@ -1,0 +1,128 @@
+"""The labelled clips of a folder: ``labels.csv`` or the ``.json`` sidecars of ``wallcli simulate``.
+
+``labels.csv`` needs the columns ``file``, ``people`` and ``activity`` (``people`` counts the
+people who *move*: someone standing still is 0, as ``wallcli count`` counts); ``detectable`` (0/1)
+is optional and every other column is ignored. A sidecar's ``people`` counts everyone in the room,
+so a count's truth there is the number of its ``activities`` other than ``none`` (what
+tests/test_examples.py checks the shipped models against). Labels that cannot be read are a
+failure of the whole run (exit 1, naming the line); a clip that is missing is not: it becomes
+that clip's error row.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from wallcli.errors import WallcliError
+
+LABELS = "labels.csv"
+REQUIRED = ("file", "people", "activity")
+
+
+@dataclass(frozen=True)
+class Clip:
+    file: str  # as the labels name it (relative to the folder, or absolute)
+    path: Path
+    people: int  # moving people
+    activity: str
+    detectable: bool | None  # None: not given
+    persons: int  # everyone in the room, still or not: activity is defined for at most one
+
+    def truth(self, task: str) -> Any:
+        return self.people if task == "count" else self.activity
+
+
+def read_labels(folder: str | Path) -> tuple[list[Clip], str]:
+    """(clips in the labels' order, where the labels came from: 'labels.csv' or 'sidecars')."""
+    d = Path(folder)
+    if not d.exists():
+        raise WallcliError(f"no such folder: {folder}")
+    if not d.is_dir():
+        raise WallcliError(f"{folder} is not a folder; give the folder that holds the clips and their labels")
+    if (d / LABELS).is_file():
+        return _from_csv(d), LABELS
+    clips = _from_sidecars(d)
+    if not clips:
+        raise WallcliError(f"{folder} has no labels: looked for {LABELS} (columns {', '.join(REQUIRED)}) and for "
+                           "*.json sidecars with 'people' and 'activity' (as 'wallcli simulate' writes them)")
+    return clips, "sidecars"
+
+
+def _from_csv(d: Path) -> list[Clip]:
+    path = d / LABELS
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as f:
+            reader = csv.DictReader(f)
+            header = [h.strip() for h in reader.fieldnames or []]
+            missing = [c for c in REQUIRED if c not in header]
+            if missing:
+                raise WallcliError(f"{path} lacks the column(s) {', '.join(missing)} (needs {', '.join(REQUIRED)}; "
+                                   f"has {', '.join(header) or 'none'})")
+            reader.fieldnames = header
+            clips = [_csv_row(path, n, row) for n, row in enumerate(reader, start=2)
+                     if any((v or "").strip() for v in row.values() if isinstance(v, str))]
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise WallcliError(f"cannot read {path}: {exc}") from None
+    if not clips:
+        raise WallcliError(f"{path} lists no clips")
+    seen: set[str] = set()
+    for c in clips:
+        if c.file in seen:
+            raise WallcliError(f"{path} lists {c.file} twice")
+        seen.add(c.file)
+    return clips
+
+
+def _csv_row(path: Path, line: int, row: dict) -> Clip:
+    where = f"{path} line {line}"
+    name = (row.get("file") or "").strip()
+    if not name:
+        raise WallcliError(f"{where}: empty 'file'")
+    people = _people(row.get("people"), where)
+    activity = (row.get("activity") or "").strip()
+    if not activity:
+        raise WallcliError(f"{where}: empty 'activity'")
+    det = (row.get("detectable") or "").strip()
+    if det not in ("", "0", "1"):
+        raise WallcliError(f"{where}: 'detectable' must be 0 or 1 (got {det!r})")
+    return Clip(name, path.parent / name, people, activity, None if det == "" else det == "1", people)
+
+
+def _people(value: Any, where: str) -> int:
+    try:
+        n = int(str(value).strip())
+    except (TypeError, ValueError):
+        raise WallcliError(f"{where}: 'people' must be a whole number (got {value!r})") from None
+    if n < 0:
+        raise WallcliError(f"{where}: 'people' must be >= 0 (got {n})")
+    return n
+
+
+def _from_sidecars(d: Path) -> list[Clip]:
+    clips = []
+    for side in sorted(d.glob("*.json")):
+        try:
+            meta = json.loads(side.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            continue  # not a sidecar (another tool's output, a report): not ours to judge
+        if not isinstance(meta, dict) or "people" not in meta or "activity" not in meta:
+            continue
+        where = str(side)
+        acts = meta.get("activities")
+        if isinstance(acts, list) and all(isinstance(a, str) for a in acts):
+            moving = sum(a != "none" for a in acts)  # a still person is not counted (count's task)
+        else:
+            moving = _people(meta["people"], where)
+        video = meta.get("video")
+        if isinstance(video, str) and video and (d / Path(video).name).exists():
+            target = d / Path(video).name
+        else:  # the video beside it: same name, any other extension
+            found = [p for p in sorted(d.glob(side.stem + ".*")) if p.suffix.lower() != ".json"]
+            target = found[0] if found else d / (side.stem + ".mp4")
+        det = meta.get("detectable")
+        clips.append(Clip(target.name, target, moving, str(meta["activity"]).strip(),
+                          None if det is None else bool(det), _people(meta["people"], where)))
+    return clips

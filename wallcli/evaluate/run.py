@@ -1,0 +1,136 @@
+"""``wallcli evaluate``: a model against a folder of labelled clips, as CONTRACT.md lays it out."""
+from __future__ import annotations
+
+import os
+from contextlib import closing
+from pathlib import Path
+from typing import Any, Callable
+
+from wallcli.errors import WallcliError
+from wallcli.evaluate import score
+from wallcli.evaluate.clip import init_worker, run_clip
+from wallcli.evaluate.labels import Clip, read_labels
+from wallcli.evaluate.pool import imap_isolated
+
+
+def default_jobs() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | None = None, roi=None,
+                    jobs: int = 0, progress: Callable[[int], None] | None = None) -> dict[str, Any]:
+    """Run ``task``'s model (the shipped one, or ``model_path``) on every labelled clip of ``folder``
+    in ``jobs`` processes (0: one per core) and score it. A clip that fails is a row with its
+    error (and a wrong answer); labels that cannot be read raise WallcliError."""
+    from wallcli.infer.model import load_model
+
+    clips, source = read_labels(folder)
+    model = load_model(task, model_path)  # checked here once: a bad model fails before any worker starts
+    classes = model.classes
+    kept, skipped = [], []
+    for c in clips:
+        if task == "activity" and c.persons > 1:
+            skipped.append(c.file)  # activity is defined for one person
+            continue
+        if c.truth(task) not in classes:
+            raise WallcliError(f"{c.file}: its label {c.truth(task)!r} is not one of the {task} model's classes "
+                               f"({', '.join(map(str, classes))})")
+        kept.append(c)
+
+    stride = int(model.card["stride"])
+    outcome: dict[int, dict] = {}
+    todo = []
+    for i, c in enumerate(kept):
+        if c.path.exists():
+            todo.append(i)
+        else:
+            outcome[i] = {"error": f"no such file: {c.file}"}
+            if progress:
+                progress(1)
+    if todo:
+        n = jobs or default_jobs()
+        initargs = (task, str(model.path), stride, tuple(roi) if roi else None)
+        with closing(imap_isolated(run_clip, [str(kept[i].path) for i in todo], jobs=n,
+                                   initializer=init_worker, initargs=initargs)) as results:
+            for k, value in results:
+                outcome[todo[k]] = value
+                if progress:
+                    progress(1)
+    rows = [_row(c, outcome[i], task) for i, c in enumerate(kept)]
+    if rows and all(r["error"] is not None for r in rows):
+        # nothing was analysed: a wrong folder, an ROI outside every frame. The work failed.
+        raise WallcliError(f"none of the {len(rows)} clips could be analysed (first, {rows[0]['file']}: "
+                           f"{rows[0]['error']})")
+    if not rows:
+        raise WallcliError(f"{folder}: no clip to score ({len(skipped)} clips of more than one person skipped)")
+    return report(rows, task=task, model=model.info(), classes=classes, folder=str(folder), labels=source,
+                  skipped=skipped, stride=stride, roi=roi)
+
+
+def _row(clip: Clip, out: dict, task: str) -> dict[str, Any]:
+    res = out.get("result")
+    err = out.get("error")
+    return {
+        "file": clip.file,
+        "truth": clip.truth(task),
+        "label": res["label"] if res else None,
+        # another module adds these to the classifier's result; absent means it was not judged
+        "confident": bool(res.get("confident", True)) if res else None,
+        "probabilities": res["probabilities"] if res else None,
+        "snr_db": out.get("snr_db"),
+        "detectable": clip.detectable,
+        "error": err,
+        "reason": res.get("reason") if res else None,
+        "snr_block": out.get("snr_block"),
+        "windows": res.get("windows_n") if res else None,
+        "warnings": out.get("warnings", []),
+    }
+
+
+def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: str, labels: str,
+           skipped: list[str], stride: int, roi) -> dict[str, Any]:
+    """The CONTRACT.md object from finished rows."""
+    for r in rows:
+        r["correct"] = score.correct(r)
+    given = any(r["detectable"] is not None for r in rows)
+    # unknown detectability (a blank cell) counts as detectable: only a stated 0 leaves the headline
+    head = [r for r in rows if r["detectable"] is not False] if given else rows
+    h = score.summary(head, classes)
+    out: dict[str, Any] = {
+        "task": task,
+        "model": model,
+        "dir": folder,
+        "clips": len(rows),
+        "scored": h["scored"],
+        "errors": sum(r["error"] is not None for r in rows),
+        "accuracy": h["accuracy"],
+        "ci95": h["ci95"],
+        "decided": h["decided"],
+        "coverage": h["coverage"],
+        "accuracy_decided": h["accuracy_decided"],
+        "classes": classes,
+        "confusion": h["confusion"],
+    }
+    if given:
+        out["all"] = score.summary(rows, classes)
+    out.update({
+        "rows": rows,
+        "correct": h["correct"],
+        "ci95_decided": h["ci95_decided"],
+        "errors_by_class": h["errors_by_class"],
+        "scored_on": "detectable clips" if given else "all clips",
+        "per_class": score.per_class(head, classes),
+        "by_snr": score.by_snr(head),
+        "reliability": score.reliability(head),
+        "skipped": skipped,
+        "labels": labels,
+        "stride": stride,
+        "roi": list(roi) if roi else None,
+        "bootstrap": {"resamples": score.BOOTSTRAP, "seed": score.SEED},
+        "snr_measure": "green-channel SNR (wallcli snr's estimator) at the block size nearest one space-time "
+                       "plot bin's area; see snr_block per row",
+    })
+    return out
