@@ -58,6 +58,12 @@ def train(
     arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the seed's nets exactly (count reads the "
                              "horizontal plot, activity both); 'lite' = both plots for either task, time averaged in "
                              "pairs and 32 channels (about a quarter of the seed count net's work; wallcli/train/nets.py)."),
+    calibrate: List[Path] = typer.Option([], "--calibrate", help="Simulated validation dataset(s) the net never trained "
+                                         "on: fit the card's decided/undetermined thresholds there (per answer and band of "
+                                         "measured signal; wallcli/infer/confidence.py). Without it, every answer of the "
+                                         "model is 'undetermined'."),
+    confidence_level: float = typer.Option(0.97, "--confidence-level", min=0.5, max=0.999, help="With --calibrate: "
+                                           "how often a decided answer must have been right in calibration."),
     init: Optional[Path] = typer.Option(None, "--init", help="Start from the weights of an exported model of the same "
                                         "task (its .onnx, float or int8): fine-tuning. The card records which."),
     lr: float = typer.Option(1e-3, "--lr", min=1e-7, max=1.0, help="RMSProp learning rate (the seed's 1e-3; "
@@ -178,12 +184,24 @@ def train(
                              + (f" --lr {lr:g}" if lr != 1e-3 else "")
                              + (f" --init {init}" if init is not None else "")
                              + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")
-                             + (f" --arch {arch}" if arch != "seed" else "")},
+                             + (f" --arch {arch}" if arch != "seed" else "")
+                             + "".join(f" --calibrate {c}" for c in calibrate)
+                             + (f" --confidence-level {confidence_level:g}" if calibrate else "")},
         validation=validation,
     )
     quant = _calibration(result, seed, prep) if quantize == "int8" else None
     card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant,
                         evaluation=_evaluation(result, prep))
+    if calibrate:
+        from wallcli.train.calibrate import calibrate as fit_confidence
+
+        block = fit_confidence(out, list(calibrate), level=confidence_level)
+        on = block["calibrated_on"]
+        log(f"confidence thresholds fitted on {on['windows']} windows: {on['coverage']:.0%} decided, "
+            f"{on['accuracy_decided'] if on['accuracy_decided'] is not None else float('nan'):.1%} of them right (in-sample)")
+        from wallcli.infer.card import read_card
+
+        card = read_card(out)
     shipped = card.get("validation") or {}  # with --quantize, the int8 graph's figure (what ships)
     acc = f", validation accuracy {shipped['accuracy']:.1%} on {shipped['windows']} windows" if shipped else ""
     log(f"wrote {out} and {card_path(out).name} (sha256 {card['sha256'][:12]}…){acc}")

@@ -101,6 +101,12 @@ def validate_card(card: Any, where: Path | str = "model card") -> None:
             raise bad(f"{key} must be a positive integer")
     if not isinstance(card["sha256"], str) or len(card["sha256"]) != 64:
         raise bad("sha256 must be 64 hex digits")
+    if card.get("confidence") is not None:
+        from wallcli.infer.confidence import validate_block
+
+        msg = validate_block(card["confidence"], len(card["classes"]))
+        if msg:
+            raise bad(msg)
 
 
 def write_card(path: Path, card: dict[str, Any]) -> None:

@@ -86,7 +86,7 @@ def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]
     t = block["thresholds"][b][k]
     level = block["level"]
     label = classes[k]
-    what = f"{label} people" if isinstance(label, int) else str(label)
+    what = (f"{label} person" if label == 1 else f"{label} people") if isinstance(label, int) else str(label)
     if t is None:
         return False, (f"at {snr_db:.0f} dB of signal ({_band_text(edges, b)}) the model was never {level:.0%} "
                        f"right when it answered '{what}' in validation")
