@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from wallcli.infer.model import load_model
-from wallcli.train.data import ShardDataset
+from wallcli.train.data import OFFSETS, ShardDataset
 from wallcli.train.metrics import VISIBLE_DB, breakdown, clip_breakdown, paired_difference, visible_mask
 
 
@@ -35,14 +35,15 @@ def _predict(task: str, ds: ShardDataset, model_path: str | None):
     probs, labels = [], []
     for i in range(len(ds.files)):
         arrays = ds._load_shard(i)
-        probs.append(model.predict({name: model.normalize(arrays[name]) for name in ds.inputs}))
+        probs.append(model.predict({name: model.normalize(arrays[name], arrays[OFFSETS[name]]) for name in model.input_names}))
         labels.append(arrays["label"])
     return model, np.concatenate(probs), np.concatenate(labels)
 
 
 def evaluate(task: str, data: str | list[str], model_path: str | None = None, visible_db: float = VISIBLE_DB,
              against: str | None = None) -> dict:
-    ds = ShardDataset(data, task)
+    # every plot any model reads, so that two models of different inputs score the same windows
+    ds = ShardDataset(data, task, inputs=["horizontal", "vertical"])
     model, p, y = _predict(task, ds, model_path)
     vis, scenes = ds.visibility(), ds.scene_ids()
     out = {"task": task, "data": data, "model": model.info(), "classes": model.classes,

@@ -97,6 +97,16 @@ def accuracy_note(card: dict) -> str | None:
     Printed under the table (to stderr, for the reader, not for scripts): a probability of 0.9
     from a model that is right on 64 % of windows is not a 90 % answer.
     """
+    tr = card.get("transfer") or {}
+    if isinstance(tr.get("accuracy"), (int, float)) and isinstance(tr.get("scored"), int):
+        # what users meet first: clips from a renderer the model never saw
+        iv = tr.get("ci95")
+        ci = f" (95 % CI {iv[0]:.0%}-{iv[1]:.0%})" if isinstance(iv, list) and len(iv) == 2 else ""
+        dec = ""
+        if isinstance(tr.get("coverage"), (int, float)) and isinstance(tr.get("accuracy_decided"), (int, float)):
+            dec = f"; it decided {tr['coverage']:.0%} of them and was right on {tr['accuracy_decided']:.0%} of those"
+        return (f"{card.get('name', 'model')} {card.get('version', '')}: right on {tr['accuracy']:.0%}{ci} of "
+                f"{tr['scored']} clips from an independent renderer{dec}. Rely on decided answers only; see the model card.")
     v = card.get("validation") or {}
     vis = v.get("visible") or {}
     if not isinstance(v.get("accuracy"), (int, float)) or not isinstance(vis.get("accuracy"), (int, float)):

@@ -1,0 +1,44 @@
+"""Record a model's transfer figures (the output of `wallcli evaluate DIR --json`) in its card.
+
+    wallcli evaluate ../shared/transfer --task count --json > runs/transfer_count.json
+    python research/record_transfer.py models/count.onnx runs/transfer_count.json
+
+The card gains a ``transfer`` block: accuracy with its 95 % interval, coverage and accuracy of the
+decided answers, the confusion matrix and per-class figures, and the command that measured them.
+The .onnx file is not touched (the card's sha256 covers only it); the card is checked to belong
+to the model that was measured, and rewritten atomically.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from wallcli.infer.card import card_path, read_card, write_card
+from wallcli.io.writer import atomic_path
+
+KEYS = ("dir", "clips", "scored", "errors", "accuracy", "ci95", "decided", "coverage", "accuracy_decided",
+        "ci95_decided", "classes", "confusion", "per_class", "all")
+
+
+def main() -> None:
+    if len(sys.argv) != 3:
+        raise SystemExit(__doc__)
+    model, result_path = Path(sys.argv[1]), Path(sys.argv[2])
+    result = json.loads(result_path.read_text(encoding="utf-8"))
+    card = read_card(model)
+    if result.get("model", {}).get("sha256") != card["sha256"]:
+        raise SystemExit(f"{result_path} measured another model ({result.get('model')}), not {model}")
+    block = {k: result[k] for k in KEYS if k in result}
+    block["source"] = ("an independent path-traced renderer (other code, box people, area lights, its own camera "
+                       "model), never trained or calibrated on")
+    block["command"] = f"wallcli evaluate {result.get('dir')} --task {result['task']} --json"
+    card["transfer"] = block
+    with atomic_path(card_path(model), force=True) as tmp:
+        write_card(tmp, card)
+    print(f"{card_path(model)}: transfer accuracy {block['accuracy']:.1%}, "
+          f"coverage {block.get('coverage', float('nan')):.0%}, decided right {block.get('accuracy_decided')}")
+
+
+if __name__ == "__main__":
+    main()
