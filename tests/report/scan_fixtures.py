@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from conftest import HOSTILE
+from report_clips import HOSTILE
 
 ACTIVITY = ["none", "walking", "crouching", "waving", "jumping"]
 

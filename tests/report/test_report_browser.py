@@ -9,6 +9,7 @@ import struct
 import browser
 import pytest
 from pagetree import parse
+from report_clips import HOSTILE
 from scan_fixtures import write_results
 
 
@@ -71,8 +72,6 @@ root.setAttribute("data-actions", JSON.stringify(out));
 
 
 def test_scan_page_in_a_browser_sorts_and_filters(tmp_path, run_cli):
-    from conftest import HOSTILE
-
     page = tmp_path / "index.html"
     code, _, err = run_cli("report", write_results(tmp_path / "results.jsonl"), "-o", page)
     assert code == 0, err

@@ -9,7 +9,7 @@ import struct
 
 import pytest
 from clips import write_clip
-from conftest import FRAMES, HOSTILE, run_main, wall_frame
+from report_clips import FRAMES, HOSTILE, run_main, wall_frame
 from pagetree import parse, table_rows
 
 SECTIONS = ("evidence", "frame", "snr", "plots", "count", "activity", "models", "method", "limits")
@@ -125,7 +125,7 @@ def test_models_come_from_their_cards(clip_report):
     assert "the card gives none" in text  # no transfer block in the shipped cards (yet)
 
 
-def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path):
+def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monkeypatch):
     """Results that carry confident=false show `undetermined (reason)`; a card's transfer block
     is shown beside its simulated figures (both written by other code, read with .get)."""
     import shutil
@@ -140,7 +140,13 @@ def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path):
                         "accuracy_decided": 0.98, "command": "wallcli evaluate transfer --task count --json",
                         "renderer": "<b>path tracer</b>"}
     (tmp_path / "count.json").write_text(json.dumps(card))
+    import wallcli.io.video as video
+
+    opened = []
+    real_open = video.open_video
+    monkeypatch.setattr(video, "open_video", lambda *a, **k: opened.append(a) or real_open(*a, **k))
     a = analyse(str(hostile_clip), models=load_models(tmp_path / "count.onnx"))
+    assert len(opened) == 1  # one decode for the frame, SNR, heatmap, plots and both models
     reason = "signal 3 dB under the model's validated range <script>"
     a.results["count"] = dict(a.results["count"], confident=False, reason=reason)
     a.results["count"]["windows"] = [dict(w, confident=False, reason=reason) for w in a.results["count"]["windows"]]
@@ -185,14 +191,18 @@ def test_roi_is_drawn_measured_and_checked(hostile_clip, tmp_path, run_cli):
     assert code == 2 and "--roi" in err
 
 
-def test_a_clip_too_short_for_a_window_still_gets_its_page(tmp_path, run_cli):
-    clip = write_clip(tmp_path / "short.mp4", wall_frame, 90)
-    out = tmp_path / "short.html"
+def test_a_truncated_clip_too_short_for_a_window_still_gets_its_page(tmp_path, run_cli):
+    whole = write_clip(tmp_path / "whole.mkv", wall_frame, 90).read_bytes()
+    clip = tmp_path / "cut.mkv"
+    clip.write_bytes(whole[: len(whole) * 6 // 10])
+    out = tmp_path / "cut.html"
     code, _, err = run_cli("report", clip, "-o", out)
     assert code == 0, err
     err = " ".join(err.split())  # rich wraps long lines
     assert "no count verdict" in err and "no activity verdict" in err and "is too short" in err
     page = parse(out.read_text(encoding="utf-8"))
+    warning = _facts(page)["Decode warnings"]
+    assert "the file looks truncated" in warning and warning in err
     for task in ("count", "activity"):
         assert "No verdict:" in page.by_id(task).text() and "too short" in page.by_id(task).text()
     assert len(page.find_all("img")) == 3

@@ -7,7 +7,7 @@ import json
 import math
 
 import pytest
-from conftest import HOSTILE
+from report_clips import HOSTILE
 from pagetree import parse, table_rows
 from scan_fixtures import RECORDS, write_results
 

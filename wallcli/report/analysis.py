@@ -114,7 +114,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     from wallcli.signal.stplot import compute_stplot
 
     if str(source).lower().endswith(".npz"):
-        raise UsageError("a report needs the video itself (its frame, SNR and identity), not a .npz plot")
+        raise WallcliError(f"{source} is a space-time plot; a report needs the video itself (its frame, SNR and identity)")
     facts = file_facts(source)
     with warnings.catch_warnings(record=True) as caught, open_video(source, threads=threads) as reader:
         warnings.simplefilter("always")
