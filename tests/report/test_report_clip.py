@@ -225,10 +225,13 @@ def test_outputs_are_atomic_and_never_overwritten_without_force(clip_report, hos
 
 
 def test_force_overwrites(tmp_path, run_cli):
-    clip = write_clip(tmp_path / "c.mp4", wall_frame, 60)
+    # the path holds '[/b]', rich's markup, and the warnings (too short) print it
+    (tmp_path / "a[").mkdir()
+    clip = write_clip(tmp_path / "a[" / "b]c.mp4", wall_frame, 60)
     out = tmp_path / "r.html"
     out.write_text("old")
     code, _, err = run_cli("report", clip, "-o", out, "--force")
     assert code == 0, err
+    assert "a[/b]c.mp4 is too short" in " ".join(err.split())
     assert out.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.mp4", "r.html"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a[", "r.html"]
