@@ -22,20 +22,23 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
          "--disable-default-apps", "--disable-extensions", "--hide-scrollbars", "--mute-audio"]
 
 PROBE = """(function () {
-  var errors = [];
+  var errors = [], root = document.documentElement;
+  function note(text) {  // kept current, so that a late report still reaches the dumped DOM
+    errors.push(text);
+    root.setAttribute("data-probe-errors", JSON.stringify(errors));
+  }
+  root.setAttribute("data-probe-errors", "[]");
   window.addEventListener("error", function (e) {
-    errors.push("error: " + (e.message || (e.target && e.target.tagName) || "?"));
+    note("error: " + (e.message || (e.target && e.target.tagName) || "?"));
   }, true);
   document.addEventListener("securitypolicyviolation", function (e) {
-    errors.push("csp: " + e.violatedDirective + " " + e.blockedURI);
+    note("csp: " + e.violatedDirective + " " + e.blockedURI);
   });
   window.addEventListener("load", function () {
-    var root = document.documentElement;
     Array.prototype.forEach.call(document.images, function (img) {
       img.setAttribute("data-natural", img.naturalWidth + "x" + img.naturalHeight + (img.complete ? "" : " incomplete"));
     });
-    try { ACTIONS } catch (e) { errors.push("probe: " + e); }
-    root.setAttribute("data-probe-errors", JSON.stringify(errors));
+    try { ACTIONS } catch (e) { note("probe: " + e); }
     root.setAttribute("data-probe-loaded", "1");
   });
 })();"""
@@ -93,7 +96,7 @@ def load(page: Path, tmp: Path, actions: str = "") -> tuple[str, list[str]]:
     """(DOM after load and the probe, console lines) of ``page``, from a probed copy."""
     copy = tmp / f"probed-{page.name}"
     copy.write_text(_with_probe(page.read_text(encoding="utf-8"), actions), encoding="utf-8")
-    done = run(["--dump-dom", copy.resolve().as_uri()], tmp)
+    done = run(["--virtual-time-budget=5000", "--dump-dom", copy.resolve().as_uri()], tmp)
     assert done.returncode == 0, done.stderr[-2000:]
     return done.stdout, console_lines(done.stderr)
 
