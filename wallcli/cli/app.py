@@ -28,6 +28,7 @@ Pipeline:  wallcli snr clip.mp4 --roi auto        # is there any signal, and whe
            wallcli count p.npz --json              # 0, 1 or 2 people
            wallcli activity clip.mp4               # none/walking/crouching/waving/jumping
            wallcli amplify clip.mp4 amp.mp4        # see the invisible signal
+           wallcli report clip.mp4 -o report.html  # one page to hand over
 
 Exit codes: 0 success, 1 input or work failed, 2 usage error.  WALLCLI_DEBUG=1 shows tracebacks.
 """
@@ -61,7 +62,7 @@ def _register() -> None:
     # One module per command; each imports only typer and the standard library at module level.
     import importlib
 
-    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate"):
+    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate", "report"):
         app.command(name)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
 
 

@@ -42,7 +42,10 @@ def log(message: str) -> None:
 
 
 def warn(message: str) -> None:
-    console_err.print(f"[yellow]Warning:[/yellow] {message}", markup=True)
+    from rich.markup import escape
+
+    # messages carry file names, which may hold '[...]' (rich markup) of any kind
+    console_err.print(f"[yellow]Warning:[/yellow] {escape(message)}", markup=True)
 
 
 def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:

@@ -46,6 +46,8 @@ class VideoInfo:
     frame_count: int | None
     pix_fmt: str
     duration: float | None
+    codec: str = ""  # FFmpeg's decoder name, e.g. 'h264' (for reports of the evidence)
+    container: str = ""  # FFmpeg's demuxer name, e.g. 'mov,mp4,m4a,3gp,3g2,mj2'
 
 
 @dataclass
@@ -236,6 +238,8 @@ class VideoReader:
             frame_count=count,
             pix_fmt=str(cc.pix_fmt or ""),
             duration=duration,
+            codec=str(cc.name or ""),
+            container=str(self._container.format.name or ""),
         )
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs

@@ -1,0 +1,94 @@
+"""``wallcli report``: one self-contained HTML page for a clip, or for a whole scan."""
+from __future__ import annotations
+
+import shlex
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, parse_roi
+
+RESULTS_SUFFIXES = (".jsonl", ".ndjson")
+
+
+def report(
+    input: str = typer.Argument(..., show_default=False, help="A video (file, http(s)/rtsp URL, or '-' for a stream on "
+                                "stdin), or the .jsonl results of 'wallcli scan'."),
+    output: Path = typer.Option(..., "--output", "-o", show_default=False, help="The HTML file to write (.html)."),
+    roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
+    count_model: Optional[Path] = typer.Option(None, "--count-model", help="Your own count .onnx (its card beside it). Default: the shipped model."),
+    activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+) -> None:
+    """Write one HTML page that opens offline in any browser and can be handed over as it is.
+
+    For a video: the evidence's identity (size, sha256, container, codec, resolution, frame
+    rate, frames decoded, decode warnings), a frame with the region analysed, signal and noise
+    per block size and where on the wall the signal is (seed §3.2), both space-time plots, the
+    count and activity answers with their per-window probabilities (or 'undetermined' and why),
+    the models with their validated accuracy and what they cannot do, and the method and its
+    limits in plain words. The video is decoded once. A clip too short for one 8.5 s window
+    still gets its page, whose answers say why there are none.
+
+    For the .jsonl of 'wallcli scan': one row per video (name, duration, SNR, count, activity,
+    confident, error), sortable by any column and filterable by text, with totals on top.
+
+    Images are embedded and the page loads nothing from anywhere: no network, scripts or fonts
+    from outside. Every name and value from the input is shown as text, never as markup.
+
+    \b
+    Examples:
+      wallcli report clip.mp4 -o clip.html
+      wallcli report clip.mp4 --roi 100,50,640,360 -o clip.html --force
+      wallcli scan cam1/*.mp4 -o results.jsonl && wallcli report results.jsonl -o index.html
+    """
+    from wallcli.errors import UsageError
+
+    if output.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"-o must end in .html (got {output})")
+    roi_t = parse_roi(roi)
+    results = str(input).lower().endswith(RESULTS_SUFFIXES)
+    if results and (roi_t or count_model or activity_model):
+        raise UsageError("--roi, --count-model and --activity-model apply to a video; scan results are already analysed")
+
+    from wallcli.cli.output import progress, warn
+    from wallcli.io.writer import check_outputs, write_text_atomic
+
+    check_outputs([output], force=force, inputs=[input, count_model, activity_model])
+    command = _command_line(input, output, roi, count_model, activity_model, force, threads)
+    if results:
+        from wallcli.report.pages import scan_page
+        from wallcli.report.scan import read_results, summarise
+
+        records, problems = read_results(input)
+        for p in problems:
+            warn(p)
+        html = scan_page(str(input), summarise(records), problems, command=command)
+    else:
+        from wallcli.report.analysis import analyse, load_models
+        from wallcli.report.pages import clip_page
+
+        models = load_models(count_model, activity_model)
+        with progress("report", None) as advance:
+            analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance)
+        for w in analysis.warnings:
+            warn(w)
+        for task, why in analysis.failures.items():
+            warn(f"no {task} verdict: {why}")
+        html = clip_page(analysis, command=command)
+    write_text_atomic(output, html, force=force)
+
+
+def _command_line(input, output, roi, count_model, activity_model, force, threads) -> str:
+    """The command as given, in canonical form (options in a fixed order; the same in-process)."""
+    args = ["wallcli", "report", str(input), "-o", str(output)]
+    for flag, value in (("--roi", roi), ("--count-model", count_model), ("--activity-model", activity_model)):
+        if value is not None:
+            args += [flag, str(value)]
+    if threads:
+        args += ["--threads", str(threads)]
+    if force:
+        args.append("--force")
+    return shlex.join(args)

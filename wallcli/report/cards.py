@@ -1,0 +1,103 @@
+"""What a report says about a model, read from its card (the card is the only source of figures).
+
+Cards written by older or newer wallcli versions differ in what they carry, so every field is
+read with ``.get`` and a missing figure is reported as missing, never invented.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+# Said of every shipped model of the task; a card's own "limitations" are listed after these.
+LIMITS = {
+    "count": [
+        "It counts people who move: 0, 1 or 2. It cannot count more than two, and it cannot tell who they are.",
+        "One against two people is its weakest distinction: two people are often counted as one.",
+        "A faint or distant mover (beyond about 3.5 m from the wall, or under heavy video compression) reads as nobody.",
+        "A person standing still may be counted when their sway shows on the wall.",
+        "It learnt from simulated rooms only; a room unlike them (other lights, other walls) can mislead it.",
+    ],
+    "activity": [
+        "It names one activity of one person: none, walking, crouching, waving or jumping; anything else is "
+        "forced into one of these.",
+        "With two or more people its answer is not defined (it learnt from scenes of at most one person).",
+        "A faint or distant mover reads as 'none'.",
+        "It learnt from simulated rooms only; a room unlike them (other lights, other walls) can mislead it.",
+    ],
+}
+
+
+def _num(x) -> float | None:
+    return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) else None
+
+
+def _ci(x) -> list[float] | None:
+    if isinstance(x, (list, tuple)) and len(x) == 2 and all(_num(v) is not None for v in x):
+        return [float(x[0]), float(x[1])]
+    return None
+
+
+def _figure(block: dict, name: str) -> dict[str, Any]:
+    """Accuracy on one simulated validation set: visible windows and all windows."""
+    vis = block.get("visible") if isinstance(block.get("visible"), dict) else {}
+    return {
+        "set": name,
+        "windows": block.get("windows"),
+        "accuracy": _num(block.get("accuracy")), "ci": _ci(block.get("accuracy_95ci")),
+        "visible_accuracy": _num(vis.get("accuracy")), "visible_ci": _ci(vis.get("accuracy_95ci")),
+        "visible_windows": vis.get("windows"), "min_snr_db": _num(vis.get("min_snr_db")),
+    }
+
+
+_TRANSFER_KNOWN = ("dir", "dataset", "set", "accuracy", "ci95", "accuracy_95ci", "clips", "scored", "coverage",
+                   "accuracy_decided", "decided", "command", "note")
+
+
+def _transfer(block: Any) -> list[dict[str, Any]] | None:
+    """The card's "transfer" figures (accuracy on an independent renderer's clips), one or a list."""
+    if block is None:
+        return None
+    out = []
+    for b in block if isinstance(block, list) else [block]:
+        if not isinstance(b, dict):
+            continue
+        # figures this page does not know by name are still shown, as they are written
+        other = {str(k): v for k, v in b.items() if k not in _TRANSFER_KNOWN and isinstance(v, (str, int, float, bool))}
+        out.append({
+            "set": b.get("dir") or b.get("dataset") or b.get("set"),
+            "accuracy": _num(b.get("accuracy")), "ci": _ci(b.get("ci95") or b.get("accuracy_95ci")),
+            "clips": b.get("scored") if b.get("scored") is not None else b.get("clips"),
+            "coverage": _num(b.get("coverage")), "accuracy_decided": _num(b.get("accuracy_decided")),
+            "command": b.get("command") if isinstance(b.get("command"), str) else None,
+            "note": b.get("note") if isinstance(b.get("note"), str) else None,
+            "other": other,
+        })
+    return out
+
+
+def model_summary(model) -> dict[str, Any]:
+    card = model.card
+    v = card.get("validation") if isinstance(card.get("validation"), dict) else {}
+    source = v.get("source") if isinstance(v.get("source"), dict) else {}
+    sets = []
+    if v:
+        sets.append(_figure(v, str(source.get("dataset") or "validation set")))
+        for o in v.get("other_sets") or []:
+            if isinstance(o, dict):
+                sets.append(_figure(o, str(o.get("dataset") or "another validation set")))
+    by_snr = []
+    for row in v.get("accuracy_by_snr") or []:
+        if isinstance(row, dict) and isinstance(row.get("snr_db"), list) and len(row["snr_db"]) == 2:
+            by_snr.append({"lo": _num(row["snr_db"][0]), "hi": _num(row["snr_db"][1]),
+                           "windows": row.get("windows"), "accuracy": _num(row.get("accuracy"))})
+    own = card.get("limitations")
+    own = [own] if isinstance(own, str) else [str(x) for x in own] if isinstance(own, list) else []
+    onnx = card.get("onnx") if isinstance(card.get("onnx"), dict) else {}
+    return {
+        "task": model.task, "name": card.get("name"), "version": card.get("version"), "sha256": card.get("sha256"),
+        "path": str(model.path), "precision": onnx.get("precision"), "created": card.get("created"),
+        "classes": [str(c) for c in model.classes], "window_s": model.window / model.fps,
+        "simulated": [s for s in sets if s["accuracy"] is not None or s["visible_accuracy"] is not None],
+        "by_snr": by_snr,
+        "transfer": _transfer(card.get("transfer")),
+        "limits": LIMITS.get(model.task, []) + own,
+    }

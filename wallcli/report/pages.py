@@ -1,0 +1,58 @@
+"""The two pages: one clip (:func:`clip_page`) and a scan's many videos (:func:`scan_page`)."""
+from __future__ import annotations
+
+from datetime import datetime, timezone
+from typing import Any
+
+from wallcli.report.render import render
+from wallcli.report.verdicts import answer
+
+CHANNELS = ("R", "G", "B")
+
+
+def _snr_rows(snr) -> list[dict[str, Any]]:
+    return [{"block": s.block, "blocks": s.blocks, "signal": [float(x) for x in s.signal_power],
+             "noise": [float(x) for x in s.noise_power], "snr_db": [float(x) for x in s.snr_db]}
+            for s in snr.scales]
+
+
+def _task_view(task: str, result: dict | None, failure: str | None, figure: str | None) -> dict[str, Any]:
+    if result is None:
+        return {"task": task, "result": None, "failure": failure or "no result", "figure": None, "windows": [],
+                "classes": [], "clip": answer(task, None), "model": None}
+    classes = [str(c) for c in result.get("classes", [])]
+    windows = []
+    for w in result.get("windows", []):
+        windows.append({"start": w.get("start"), "end": w.get("end"), "answer": answer(task, w),
+                        "probabilities": list(w.get("probabilities") or [])})
+    return {"task": task, "result": result, "failure": None, "figure": figure, "windows": windows,
+            "classes": classes, "clip": answer(task, result), "probabilities": list(result.get("probabilities") or []),
+            "undetermined": sum(not w["answer"]["decided"] for w in windows)}
+
+
+def clip_page(a, *, command: str) -> str:
+    """The HTML report of a :class:`wallcli.report.analysis.ClipAnalysis`."""
+    from wallcli.report.cards import model_summary
+    from wallcli.report.figures import clip_figures
+
+    figures = clip_figures(a)
+    tasks = [_task_view(t, a.results.get(t), a.failures.get(t), figures.get(f"timeline_{t}"))
+             for t in ("count", "activity")]
+    return render(
+        "clip.html.j2",
+        title=a.identity["path"], identity=a.identity, command=command, roi=list(a.roi),
+        snr={"rows": _snr_rows(a.snr), "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
+             "pixels": a.snr.sampled_pixels, "channels": CHANNELS},
+        grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
+        plot={"bins": a.plot.bins, "frames": a.plot.frames},
+        figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],
+    )
+
+
+def scan_page(source: str, summary: dict[str, Any], problems: list[str], *, command: str) -> str:
+    return render(
+        "index.html.j2", scripts=("table.js",),
+        title=source, source=source, rows=summary["rows"], totals=summary["totals"], problems=problems,
+        command=command,
+        generated=datetime.now(timezone.utc).isoformat(timespec="seconds"),
+    )

@@ -1,0 +1,109 @@
+"""The summary of a ``wallcli scan`` run: its JSON Lines (CONTRACT.md), one row per video.
+
+A scan writes and flushes one line per video as it finishes, so a killed scan leaves a file
+whose last line may be cut short; a line that is not a JSON object becomes a row carrying that
+error instead of stopping the summary.
+"""
+from __future__ import annotations
+
+import json
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+from wallcli.report.verdicts import answer
+
+TASKS = ("count", "activity")
+
+
+def _num(x) -> float | None:
+    return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) else None
+
+
+def read_results(path: str | Path) -> tuple[list[dict[str, Any]], list[str]]:
+    """(records, problems): every non-blank line, a dict or a stand-in carrying its error."""
+    try:
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        raise WallcliError(f"no such file: {path}") from None
+    except IsADirectoryError:
+        raise WallcliError(f"{path} is a folder, not a results file") from None
+    except OSError as exc:
+        raise WallcliError(f"cannot read {path}: {exc.strerror or exc}") from None
+    records, problems = [], []
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            rec = json.loads(line)
+        except json.JSONDecodeError as exc:
+            rec = None
+            why = f"line {n} is not JSON ({exc.msg}); a scan stopped while writing it?"
+        else:
+            why = f"line {n} is not a JSON object"
+        if not isinstance(rec, dict):
+            problems.append(f"{path}: {why}")
+            rec = {"input": f"(line {n})", "error": why}
+        records.append(rec)
+    if not records:
+        raise WallcliError(f"{path} holds no results (expected one JSON object per line, as 'wallcli scan' writes)")
+    return records, problems
+
+
+def snr_figure(snr: Any) -> float | None:
+    """One SNR per video: per pixel (seed §3.2), of R, G and B together (their powers averaged)."""
+    from wallcli.signal.snr import snr_db
+
+    if not isinstance(snr, dict):
+        return None
+    sig, noi = snr.get("signal_power"), snr.get("noise_power")
+    if isinstance(sig, list) and isinstance(noi, list) and sig and len(sig) == len(noi) \
+            and all(_num(x) is not None for x in sig + noi):
+        return float(snr_db(np.mean(sig), np.mean(noi)))
+    db = snr.get("snr_db")
+    if isinstance(db, list) and db and all(_num(x) is not None for x in db):
+        return float(np.mean(db))
+    return None
+
+
+def _row(rec: dict[str, Any]) -> dict[str, Any]:
+    error = rec.get("error")
+    error = None if error is None else " ".join(str(error).split())
+    tasks = {t: answer(t, rec.get(t)) if isinstance(rec.get(t), dict) else None for t in TASKS}
+    flags = [a["confident"] for a in tasks.values() if a is not None]
+    confident = False if False in flags else (True if flags and all(f is True for f in flags) else None)
+    size = rec.get("size")
+    return {
+        "name": str(rec.get("input")) if rec.get("input") is not None else "(no input named)",
+        "duration": _num(rec.get("duration")), "frames": _num(rec.get("frames")),
+        "size": size if isinstance(size, int) and not isinstance(size, bool) else None,
+        "sha256": rec.get("sha256") if isinstance(rec.get("sha256"), str) else None,
+        "snr_db": snr_figure(rec.get("snr")),
+        "count": tasks["count"], "activity": tasks["activity"],
+        "confident": confident, "error": error,
+    }
+
+
+def summarise(records: list[dict[str, Any]]) -> dict[str, Any]:
+    rows = [_row(r) for r in records]
+    ok = [r for r in rows if r["error"] is None]
+
+    def tally(task):
+        c = Counter("undetermined" if not r[task]["decided"] else r[task]["label"] for r in ok if r[task] is not None)
+        return sorted(c.items(), key=lambda kv: (kv[0] == "undetermined", kv[0]))
+
+    return {
+        "rows": rows,
+        "totals": {
+            "videos": len(rows), "ok": len(ok), "failed": len(rows) - len(ok),
+            "duration": sum(r["duration"] or 0.0 for r in ok),
+            "frames": int(sum(r["frames"] or 0 for r in ok)),
+            "size": sum(r["size"] or 0 for r in rows),
+            "confident": sum(r["confident"] is True for r in ok),
+            "undetermined": sum(r["confident"] is False for r in ok),
+            "count": tally("count"), "activity": tally("activity"),
+        },
+    }
