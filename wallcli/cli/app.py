@@ -61,7 +61,7 @@ def _register() -> None:
     # One module per command; each imports only typer and the standard library at module level.
     import importlib
 
-    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train"):
+    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "scan"):
         app.command(name)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
 
 

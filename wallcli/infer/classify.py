@@ -86,6 +86,40 @@ def _predict_window(model, win: np.ndarray) -> np.ndarray:
     return model.predict({n: model.normalize(parts[n][None]) for n in model.input_names})[0]
 
 
+class WindowClassifier:
+    """The windows of a stream of rows, classified as they complete, and the clip's result.
+
+    The streaming half of :func:`classify_video`, for callers that decode themselves: ``wallcli
+    scan`` feeds one decode to a classifier per task (and to the SNR estimator).  Rows are
+    :class:`RowStream`'s (horizontal bins first, then vertical).
+    """
+
+    def __init__(self, model, stride: int):
+        self.model, self.stride = model, int(stride)
+        self.windower = StreamWindower(model.window, stride)
+        self.times, self.probs = [], []
+        self._emitted = 0  # rows seen when the newest window was classified
+
+    def push(self, t: float, row: np.ndarray) -> None:
+        done = self.windower.push(t, row)
+        if done is not None:
+            self.times.append(done[0])
+            self.probs.append(_predict_window(self.model, done[2]))
+            self._emitted = self.windower.count
+
+    def result(self, source: str) -> dict[str, Any]:
+        """The CONTRACT.md result; WallcliError when the stream was shorter than one window."""
+        model, w = self.model, self.windower
+        last = w.last()
+        if last is None:
+            raise _too_short(str(source), w.count, model)
+        times, probs = list(self.times), list(self.probs)
+        if self._emitted != w.count:  # window_starts' end-aligned window: the last `window` rows
+            times.append(last[0])
+            probs.append(_predict_window(model, last[2]))
+        return _result(model, times, np.stack(probs), stride=self.stride, source=str(source))
+
+
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
                    keep_plot: bool = False):
     """(result, plot) for a video, decoded once into windows classified as they complete.
@@ -98,27 +132,16 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.io.video import open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
 
-    windower = StreamWindower(model.window, stride)
+    classifier = WindowClassifier(model, stride)
     thumb = PlotThumbnail() if keep_plot else None
-    times, probs, emitted = [], [], 0  # emitted: rows seen when the newest window was classified
     with open_video(source, threads=threads) as reader:
         rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, progress=progress,
                          vertical=keep_plot or "vertical" in model.input_names)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
-            done = windower.push(t, row)
-            if done is not None:
-                times.append(done[0])
-                probs.append(_predict_window(model, done[2]))
-                emitted = windower.count
-    last = windower.last()
-    if last is None:
-        raise _too_short(str(source), windower.count, model)
-    if emitted != windower.count:  # window_starts' end-aligned window: the last `window` rows
-        times.append(last[0])
-        probs.append(_predict_window(model, last[2]))
-    result = _result(model, times, np.stack(probs), stride=stride, source=str(source))
+            classifier.push(t, row)
+    result = classifier.result(str(source))
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
