@@ -105,7 +105,11 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
                 return {"input": source, "size": None, "sha256": None, "duration": None, "frames": None,
                         "tasks": list(tasks), "error": " ".join(message.split())}
 
-            with Engine(workers=workers, scheduler=scheduler, log=log, debug=debug) as engine:
+            from wallcli.batch.engine import default_workers
+
+            # no more local workers than videos: each costs a process start and the models' load
+            local = min(workers or default_workers(), len(todo))
+            with Engine(workers=local, scheduler=scheduler, log=log, debug=debug) as engine:
                 engine_workers = engine.workers
                 for _, line in engine.map(scan_video, todo, config, failed=failed_line):
                     results.append(line)

@@ -10,7 +10,8 @@ import typer
 
 def scan(
     inputs: List[str] = typer.Argument(..., help="Video files, folders (searched recursively, see --glob), http(s)/rtsp "
-                                       "URLs, or @list.txt (one path or URL a line, # comments).", show_default=False),
+                                       "URLs, or @list.txt (one path or URL a line, # comments).", show_default=False,
+                                       metavar="INPUT"),
     output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see CONTRACT.md), "
                                 "or flattened CSV when the name ends in .csv. An existing file is resumed.",
                                 show_default=False),
@@ -56,6 +57,10 @@ def scan(
     from wallcli.cli.output import emit_json, log, to_json
 
     tasks = parse_tasks(task)
+    if workers is not None and scheduler is not None:
+        from wallcli.errors import UsageError
+
+        raise UsageError("--workers sizes the cluster on this machine; a --scheduler has its own workers")
     debug = os.environ.get("WALLCLI_DEBUG", "") not in ("", "0")
     state = {"hours": 0.0, "failed": 0}
 
