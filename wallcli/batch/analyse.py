@@ -62,8 +62,8 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
                 on_frame()
 
         tee = _Tee(reader, each)
-        if classify:
-            classifiers = [WindowClassifier(m, int(m.card["stride"])) for m in used]
+        classifiers = [WindowClassifier(m, int(m.card["stride"])) for m in used]
+        if classifiers:
             vertical = any("vertical" in m.input_names for m in used)
             for t, row in RowStream(tee, bins=used[0].bins, fps=used[0].fps, vertical=vertical):
                 for c in classifiers:
@@ -75,7 +75,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         notes = list(reader.warnings)
     out: dict[str, Any] = {"frames": state["frames"], "duration": round(state["last"] + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes}
-    for task, c in zip(classify, classifiers if classify else []):
+    for task, c in zip(classify, classifiers):
         out[task] = c.result(source)
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame")
