@@ -62,7 +62,7 @@ def _register() -> None:
     # One module per command; each imports only typer and the standard library at module level.
     import importlib
 
-    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate", "report"):
+    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate", "report", "scan"):
         app.command(name)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
 
 
@@ -82,12 +82,13 @@ def _fail(message: str, code: int) -> None:
 
 
 def _click_exceptions():
-    # typer >= 0.16 vendors click as typer._click; older ones depend on click itself.
+    # typer >= 0.16 vendors click as typer._click; older ones depend on click itself. The vendored
+    # one first: click may be installed beside it (dask needs it), but typer raises its own.
     try:
-        from click.exceptions import Abort, ClickException, Exit, UsageError
-    except ImportError:
         from typer._click.exceptions import ClickException, UsageError
         from typer.exceptions import Abort, Exit
+    except ImportError:
+        from click.exceptions import Abort, ClickException, Exit, UsageError
     return Abort, ClickException, Exit, UsageError
 
 

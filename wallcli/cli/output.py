@@ -37,8 +37,10 @@ def emit_json(obj: Any) -> None:
     sys.stdout.flush()
 
 
-def log(message: str) -> None:
-    console_err.print(message)
+def log(message: str, *, wrap: bool = True) -> None:
+    """A line for the reader on stderr; ``wrap=False`` for lines that name files (no break inside
+    a path, so grep finds it)."""
+    console_err.print(message, soft_wrap=not wrap)
 
 
 def warn(message: str) -> None:
@@ -80,3 +82,33 @@ def progress(description: str, total: int | None, *, enabled: bool = True) -> It
     with Progress(*cols, console=console_err, transient=True) as bar:
         task = bar.add_task(description, total=total)
         yield lambda n=1: bar.advance(task, n)
+
+
+@contextmanager
+def batch_progress(description: str, total: int, unit: str = "videos", *, enabled: bool = True) -> Iterator[Any]:
+    """A bar for many items (``wallcli scan``): done / total, hours of video, rate, ETA, failures.
+
+    Yields ``update(hours, failed)``, called after each item. Silent when stderr is not a terminal.
+    """
+    if not enabled or not console_err.is_terminal:
+        yield lambda hours, failed: None
+        return
+    import time
+
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    cols = [TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn(unit),
+            TextColumn("{task.fields[hours]:.2f} h of video"), TextColumn("{task.fields[rate]}"),
+            TimeRemainingColumn(), TextColumn("{task.fields[failed]}")]
+    t0 = time.monotonic()
+    with Progress(*cols, console=console_err, transient=True) as bar:
+        task = bar.add_task(description, total=total, hours=0.0, rate="", failed="")
+
+        def update(hours: float, failed: int) -> None:
+            bar.advance(task, 1)
+            done = bar.tasks[0].completed
+            rate = done / max(time.monotonic() - t0, 1e-9)
+            bar.update(task, hours=hours, rate=f"{rate:.2f} {unit}/s" if rate >= 0.1 else f"{60 * rate:.2f} {unit}/min",
+                       failed=f"[red]{failed} failed[/red]" if failed else "0 failed")
+
+        yield update

@@ -104,7 +104,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.snr import CHANNELS, GridAccumulator, SnrAccumulator, snr_db
+    from wallcli.signal.snr import GridAccumulator, SnrAccumulator, snr_db, snr_report
 
     auto = roi is not None and roi.strip().lower() == "auto"
     roi_t = None if auto else parse_roi(roi)
@@ -138,28 +138,10 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
                 advance()
         fps = float(reader.info.fps)
     notes += [str(w.message) for w in caught]
-    if acc.frames < 3:
-        raise WallcliError(f"{input}: only {acc.frames} frame(s) decoded; the noise estimate needs at least 3 "
-                           "(it compares consecutive frames over time)")
+    result = snr_report(acc, source=input, fps=fps, notes=notes,
+                        roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))
     res = acc.result()
-    notes += res.warnings
-    top = res.scale(1)
-    result = {
-        "input": input,
-        "roi": list(res.roi),
-        "frames": res.frames,
-        "channels": list(CHANNELS),
-        "signal_power": top.signal_power.tolist(),
-        "noise_power": top.noise_power.tolist(),
-        "snr_db": top.snr_db.tolist(),
-        "scales": [{"block": s.block, "signal_power": s.signal_power.tolist(), "noise_power": s.noise_power.tolist(),
-                    "snr_db": s.snr_db.tolist(), "blocks": s.blocks} for s in res.scales],
-        "fps": fps,
-        "roi_mode": "auto" if auto else ("given" if roi_t is not None else "frame"),
-        "sampled_pixels": res.sampled_pixels,
-        "exact": res.exact,
-        "warnings": notes,
-    }
+    notes = result["warnings"]
     if auto:
         result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
                           "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0))}

@@ -101,6 +101,47 @@ def _predict_window(model, win: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray
     return probs, float(window_signal_db([(parts[n][None], refs[n]) for n in model.input_names])[0])
 
 
+class WindowClassifier:
+    """The windows of a stream of rows, classified as they complete, and the clip's result.
+
+    The streaming half of :func:`classify_video`, for callers that decode themselves: ``wallcli
+    scan`` feeds one decode to a classifier per task (and to the SNR estimator).  Rows are
+    :class:`RowStream`'s (horizontal bins first, then vertical), pushed with that stream's ``ref``
+    (the level they are relative to).
+    """
+
+    def __init__(self, model, stride: int):
+        self.model, self.stride = model, int(stride)
+        self.windower = StreamWindower(model.window, stride)
+        self.times, self.probs, self.signal = [], [], []
+        self.ref = None
+        self._emitted = 0  # rows seen when the newest window was classified
+
+    def push(self, t: float, row: np.ndarray, ref: np.ndarray) -> None:
+        self.ref = ref
+        done = self.windower.push(t, row)
+        if done is not None:
+            p, db = _predict_window(self.model, done[2], ref)
+            self.times.append(done[0])
+            self.probs.append(p)
+            self.signal.append(db)
+            self._emitted = self.windower.count
+
+    def result(self, source: str) -> dict[str, Any]:
+        """The CONTRACT.md result; WallcliError when the stream was shorter than one window."""
+        model, w = self.model, self.windower
+        last = w.last()
+        if last is None:
+            raise _too_short(str(source), w.count, model)
+        times, probs, signal = list(self.times), list(self.probs), list(self.signal)
+        if self._emitted != w.count:  # window_starts' end-aligned window: the last `window` rows
+            p, db = _predict_window(model, last[2], self.ref)
+            times.append(last[0])
+            probs.append(p)
+            signal.append(db)
+        return _result(model, times, np.stack(probs), np.asarray(signal), stride=self.stride, source=str(source))
+
+
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
                    keep_plot: bool = False, taps=()):
     """(result, plot) for a video, decoded once into windows classified as they complete.
@@ -114,31 +155,16 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
 
-    windower = StreamWindower(model.window, stride)
+    classifier = WindowClassifier(model, stride)
     thumb = PlotThumbnail() if keep_plot else None
-    times, probs, signal, emitted = [], [], [], 0  # emitted: rows seen when the newest window was classified
     with open_video(source, threads=threads) as reader:
         rows = RowStream(FrameTee(reader, taps) if taps else reader, roi=roi, bins=model.bins, fps=model.fps,
                          progress=progress, vertical=keep_plot or "vertical" in model.input_names)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
-            done = windower.push(t, row)
-            if done is not None:
-                times.append(done[0])
-                p, db = _predict_window(model, done[2], rows.ref)
-                probs.append(p)
-                signal.append(db)
-                emitted = windower.count
-    last = windower.last()
-    if last is None:
-        raise _too_short(str(source), windower.count, model)
-    if emitted != windower.count:  # window_starts' end-aligned window: the last `window` rows
-        times.append(last[0])
-        p, db = _predict_window(model, last[2], rows.ref)
-        probs.append(p)
-        signal.append(db)
-    result = _result(model, times, np.stack(probs), np.asarray(signal), stride=stride, source=str(source))
+            classifier.push(t, row, rows.ref)
+    result = classifier.result(str(source))
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 

@@ -340,6 +340,36 @@ class FrameSnr:
         return self.acc.result()
 
 
+def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, notes=()) -> dict:
+    """The object of ``wallcli snr --json`` (CONTRACT.md) from a fed accumulator.
+
+    One builder for ``wallcli snr`` and ``wallcli scan`` (which feeds the accumulator from the
+    decode that also makes the space-time plots), so both report the same fields.  ``notes``:
+    the reader's warnings, listed before the estimator's own.
+    """
+    if acc.frames < MIN_FRAMES:
+        raise WallcliError(f"{source}: only {acc.frames} frame(s) decoded; the noise estimate needs at least "
+                           f"{MIN_FRAMES} (it compares consecutive frames over time)")
+    res = acc.result()
+    top = res.scale(1)
+    return {
+        "input": source,
+        "roi": list(res.roi),
+        "frames": res.frames,
+        "channels": list(CHANNELS),
+        "signal_power": top.signal_power.tolist(),
+        "noise_power": top.noise_power.tolist(),
+        "snr_db": top.snr_db.tolist(),
+        "scales": [{"block": s.block, "signal_power": s.signal_power.tolist(), "noise_power": s.noise_power.tolist(),
+                    "snr_db": s.snr_db.tolist(), "blocks": s.blocks} for s in res.scales],
+        "fps": fps,
+        "roi_mode": roi_mode,
+        "sampled_pixels": res.sampled_pixels,
+        "exact": res.exact,
+        "warnings": [*notes, *res.warnings],
+    }
+
+
 # ---------------------------------------------------------------------------------- maps / auto ROI
 def grid_shape(w: int, h: int, long_side: int, fy: int = 1, fx: int = 1) -> tuple[int, int, int, int]:
     """(rows, cols, cell_h, cell_w): about square cells of whole chroma samples, <= long_side per side."""

@@ -1,0 +1,83 @@
+"""One video, one decode, every task asked for.
+
+Each decoded frame goes to the SNR estimator (its planes, as in ``wallcli snr``) and to the
+space-time rows (:class:`~wallcli.infer.stream.RowStream`, as ``wallcli count``/``activity`` read a
+video), whose windows go to one :class:`~wallcli.infer.classify.WindowClassifier` per
+classification task. Same frames, same functions, same defaults (the whole frame, the model
+card's stride) as the single-video commands, so the answers are theirs, for a third of the
+decoding. Memory stays flat in the video's length, as theirs does.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+TASKS = ("count", "activity", "snr")
+CLASSIFY = ("count", "activity")
+
+
+class _Tee:
+    """A reader whose frames also go to ``each`` on their way to the reader's consumer."""
+
+    def __init__(self, reader, each: Callable):
+        self.reader, self.info, self.each = reader, reader.info, each
+
+    def frames(self):
+        for frame in self.reader.frames():
+            self.each(frame)
+            yield frame
+
+
+def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
+            on_frame: Callable[[], None] | None = None) -> dict[str, Any]:
+    """``{"frames", "duration", "fps", "warnings", <task>: <its --json object>, ...}`` for ``source``.
+
+    ``models``: a loaded :class:`~wallcli.infer.model.Model` per classification task asked for.
+    ``on_frame`` is called after every decoded frame (a watchdog's heartbeat; it may raise to
+    abandon the video). Raises WallcliError when the video cannot be read or is too short for a
+    task: a video either has every answer asked for or none.
+    """
+    from wallcli.errors import WallcliError
+    from wallcli.infer.classify import WindowClassifier
+    from wallcli.infer.stream import RowStream
+    from wallcli.io.video import open_video
+    from wallcli.signal.blocks import check_roi
+    from wallcli.signal.snr import SnrAccumulator, snr_report
+
+    classify = [t for t in CLASSIFY if t in tasks]
+    used = [models[t] for t in classify]
+    if len({(m.bins, m.fps) for m in used}) > 1:
+        raise WallcliError("the count and activity models read plots of different bins or frame rates; "
+                           "one decode cannot feed both")
+    state = {"frames": 0, "last": 0.0}
+    with open_video(source, threads=decoder_threads) as reader:
+        info = reader.info
+        snr = SnrAccumulator(check_roi(None, info.width, info.height)) if "snr" in tasks else None
+
+        def each(frame) -> None:
+            if snr is not None:
+                snr.update(frame.planes)
+            state["frames"] += 1
+            state["last"] = frame.time
+            if on_frame is not None:
+                on_frame()
+
+        tee = _Tee(reader, each)
+        classifiers = [WindowClassifier(m, int(m.card["stride"])) for m in used]
+        if classifiers:
+            vertical = any("vertical" in m.input_names for m in used)
+            rows = RowStream(tee, bins=used[0].bins, fps=used[0].fps, vertical=vertical)
+            for t, row in rows:
+                for c in classifiers:
+                    c.push(t, row, rows.ref)
+        else:
+            for _ in tee.frames():
+                pass
+        fps = float(info.fps)
+        notes = list(reader.warnings)
+    out: dict[str, Any] = {"frames": state["frames"], "duration": round(state["last"] + 1.0 / fps, 6), "fps": fps,
+                           "warnings": notes}
+    for task, c in zip(classify, classifiers):
+        out[task] = c.result(source)
+    if snr is not None:
+        out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame")
+    return out

@@ -1,0 +1,89 @@
+"""What ``wallcli scan`` reads: files, folders searched recursively, and ``@list.txt`` files."""
+from __future__ import annotations
+
+import fnmatch
+import os
+from pathlib import Path
+
+from wallcli.errors import WallcliError
+
+VIDEO_EXTENSIONS = (".mp4", ".mov", ".m4v", ".mkv", ".webm", ".avi", ".ts", ".mts", ".m2ts", ".mpg", ".mpeg",
+                    ".wmv", ".flv", ".3gp", ".nut", ".y4m")
+
+
+def is_url(source: str) -> bool:
+    return "://" in source
+
+
+def _matches(name: str, globs: list[str] | None) -> bool:
+    if not globs:
+        return name.lower().endswith(VIDEO_EXTENSIONS)
+    return any(fnmatch.fnmatchcase(name, g) for g in globs)
+
+
+def _walk(folder: str, globs: list[str] | None) -> list[str]:
+    found = []
+    for root, dirs, files in os.walk(folder):
+        # hidden entries: editors' and wallcli's own temporaries (.NAME.XXXX.tmp.mp4), .git
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+        found += [os.path.join(root, f) for f in sorted(files) if not f.startswith(".") and _matches(f, globs)]
+    return found
+
+
+def _read_list(arg: str) -> list[str]:
+    path = Path(arg[1:])
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise WallcliError(f"no such list file: {path}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WallcliError(f"cannot read the list file {path}: {exc}") from None
+    # one path or URL a line; blank lines and '#' comments skipped. Entries are taken as written
+    # (relative to the current folder, as a shell loop over them would); a missing one becomes an
+    # error line of the results, not a stop
+    return [s for s in (line.strip() for line in text.splitlines()) if s and not s.startswith("#")]
+
+
+def expand_inputs(args: list[str], globs: list[str] | None = None) -> list[str]:
+    """The videos named by ``args``, in order, each once.
+
+    A folder gives the files under it whose names match ``globs`` (default: the usual video
+    extensions, any case); a file or URL is taken as is; ``@list.txt`` gives its lines. A path on
+    the command line that does not exist is an error (a typo should not cost a run), and so is
+    finding no video at all.
+    """
+    out: list[str] = []
+    seen: set[str] = set()
+    empty_folders = []
+
+    def add(source: str) -> None:
+        key = source if is_url(source) else os.path.realpath(source)
+        if key not in seen:
+            seen.add(key)
+            out.append(source)
+
+    for arg in args:
+        if arg == "-":
+            raise WallcliError("scan reads files, folders, URLs and @lists, not '-' "
+                               "(a stream on stdin cannot be resumed or shared between workers)")
+        if arg.startswith("@"):
+            for entry in _read_list(arg):
+                add(entry)
+        elif is_url(arg):
+            add(arg)
+        elif os.path.isdir(arg):
+            found = _walk(arg, globs)
+            if not found:
+                empty_folders.append(arg)
+            for f in found:
+                add(f)
+        elif os.path.exists(arg):
+            add(arg)
+        else:
+            raise WallcliError(f"no such file or folder: {arg}")
+    if not out:
+        looked = ", ".join(globs) if globs else "*" + ", *".join(VIDEO_EXTENSIONS)
+        where = ", ".join(empty_folders) if empty_folders else "the inputs"
+        raise WallcliError(f"no videos found in {where} (looked for {looked})",
+                           hint="give --glob for other names")
+    return out

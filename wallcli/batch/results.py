@@ -1,0 +1,197 @@
+"""The results file of ``wallcli scan``: JSON Lines (or CSV), appended line by line.
+
+The file is the run's only memory. Every finished video's line is written, flushed and fsynced
+before the next one is, so a crash, Ctrl-C or ``kill -9`` leaves every finished line intact and
+at most one torn last line, which the next run drops. On that next run, lines of videos that are
+unchanged (same sha256) and scanned for the same tasks are kept and their videos skipped;
+errors and videos that changed are done again and their old lines dropped, so each video keeps
+exactly one line.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from wallcli.errors import WallcliError
+
+BASE = ["input", "size", "sha256", "duration", "frames", "tasks", "seconds", "error", "warnings"]
+CHANNELS = ("r", "g", "b")
+
+
+def is_csv(path: str | os.PathLike) -> bool:
+    return str(path).lower().endswith(".csv")
+
+
+def key(source: str) -> str:
+    """Which video a line is about: its input as written, normalised (./a.mp4 == a.mp4)."""
+    return source if "://" in source else os.path.normpath(source)
+
+
+# ------------------------------------------------------------------------------------------ CSV
+def csv_columns(tasks, classes: dict[str, list], windows: bool = False) -> list[str]:
+    """The CSV header: fixed by the tasks and the models' classes, so rows of any video line up."""
+    cols = list(BASE)
+    for task in ("count", "activity"):
+        if task in tasks:
+            cols += [f"{task}.label", f"{task}.confident", f"{task}.reason"]
+            cols += [f"{task}.probabilities.{c}" for c in classes[task]]
+            cols += [f"{task}.model.name", f"{task}.model.version", f"{task}.model.sha256"]
+            cols += [f"{task}.windows"] if windows else []
+    if "snr" in tasks:
+        cols += ["snr.roi", "snr.frames"]
+        cols += [f"snr.{q}.{c}" for q in ("signal_power", "noise_power", "snr_db") for c in CHANNELS]
+        cols += ["snr.sampled_pixels", "snr.exact", "snr.scales"]
+    return cols
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float, str)):
+        return str(value)
+    return json.dumps(value, ensure_ascii=False)  # lists of objects (windows, scales), warnings
+
+
+def flatten(line: dict, columns: list[str]) -> list[str]:
+    """One CSV row: nested objects joined with '.', lists named by the classes or channels beside
+    them; whatever is not a column (the full objects' other fields) is left to the JSON format."""
+    flat: dict[str, Any] = {k: line.get(k) for k in BASE}
+    flat["tasks"] = ",".join(line.get("tasks") or [])
+    for task in ("count", "activity", "snr"):
+        obj = line.get(task)
+        if not isinstance(obj, dict):
+            continue
+        names = obj.get("classes") if task != "snr" else obj.get("channels")
+        for k, v in obj.items():
+            if isinstance(v, dict):
+                flat.update({f"{task}.{k}.{kk}": vv for kk, vv in v.items()})
+            elif isinstance(v, list) and names and len(v) == len(names) and k != "roi" \
+                    and all(isinstance(x, (int, float)) for x in v):
+                flat.update({f"{task}.{k}.{n}": x for n, x in zip(names, v)})
+            elif k == "roi" and isinstance(v, list):
+                flat[f"{task}.roi"] = ",".join(str(x) for x in v)
+            else:
+                flat[f"{task}.{k}"] = v
+    return [_cell(flat.get(c)) for c in columns]
+
+
+# ------------------------------------------------------------------------------------- reading
+@dataclass
+class Entry:
+    raw: str  # the line as stored, newline excluded: kept lines are written back byte for byte
+    input: str
+    size: int | None
+    sha256: str | None
+    tasks: tuple[str, ...]
+    error: str | None
+
+
+def _entry_json(raw: str) -> Entry | None:
+    try:
+        d = json.loads(raw)
+    except json.JSONDecodeError:
+        return None
+    if not isinstance(d, dict) or not isinstance(d.get("input"), str) or not isinstance(d.get("tasks"), list):
+        return None
+    return Entry(raw, d["input"], d.get("size"), d.get("sha256"), tuple(d["tasks"]), d.get("error"))
+
+
+def _entry_csv(raw: str, header: list[str]) -> Entry | None:
+    try:
+        row = next(csv.reader(io.StringIO(raw)))
+    except (csv.Error, StopIteration):
+        return None
+    if len(row) != len(header):
+        return None
+    d = dict(zip(header, row))
+    try:
+        size = int(d["size"]) if d["size"] else None
+    except ValueError:
+        return None
+    return Entry(raw, d["input"], size, d["sha256"] or None, tuple(t for t in d["tasks"].split(",") if t),
+                 d["error"] or None)
+
+
+def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
+    """(entries, torn): the lines of an earlier run; ``torn`` when its last line was cut short.
+
+    Anything else that is not a line of ours means the file is not a scan's results: refusing to
+    append to it (or to rewrite it) keeps someone's other file safe.
+    """
+    data = path.read_bytes()
+    torn = bool(data) and not data.endswith(b"\n")
+    try:
+        lines = data.decode("utf-8").split("\n")
+    except UnicodeDecodeError:
+        raise WallcliError(f"{path} is not a wallcli scan results file (not UTF-8 text)",
+                           hint="choose another -o, or --force to replace it") from None
+    lines = lines[:-1]  # the text after the last newline: '' or the torn line
+    if columns is not None and lines:
+        header = next(csv.reader([lines[0]]))
+        if header != columns:
+            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
+                               hint="use the same options, another -o, or --force to start it again")
+        lines = lines[1:]
+    entries = []
+    for n, raw in enumerate(lines, start=2 if columns is not None else 1):
+        if not raw.strip():
+            continue
+        e = _entry_csv(raw, columns) if columns is not None else _entry_json(raw)
+        if e is None:
+            raise WallcliError(f"{path} line {n} is not a wallcli scan result",
+                               hint="choose another -o, or --force to replace the file")
+        entries.append(e)
+    return entries, torn
+
+
+# ------------------------------------------------------------------------------------- writing
+class ResultsFile:
+    """Append-only writer of one line per video; ``header`` (CSV) is written once, at creation."""
+
+    def __init__(self, path: Path, encode: Callable[[dict], str], columns: list[str] | None = None):
+        self.path, self.encode, self.columns = Path(path), encode, columns
+        self._fh = None
+
+    def _format(self, line: dict) -> str:
+        if self.columns is None:
+            return self.encode(line)
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="").writerow(flatten(line, self.columns))
+        return buf.getvalue()
+
+    def _header(self) -> list[str]:
+        if self.columns is None:
+            return []
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="").writerow(self.columns)
+        return [buf.getvalue()]
+
+    def start(self, kept: list[Entry] | None) -> None:
+        """Open for appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
+        atomically, by a fresh file holding the header and ``kept``'s lines."""
+        if kept is not None:
+            from wallcli.io.writer import atomic_path
+
+            with atomic_path(self.path, force=True) as tmp:
+                text = "".join(f"{raw}\n" for raw in self._header() + [e.raw for e in kept])
+                tmp.write_text(text, encoding="utf-8")
+        self._fh = open(self.path, "a", encoding="utf-8", newline="")
+
+    def append(self, line: dict) -> None:
+        # one write of the whole line, then flush and fsync: the line is on disk before the next
+        # one starts, and a kill can tear at most the line being written
+        self._fh.write(self._format(line) + "\n")
+        self._fh.flush()
+        os.fsync(self._fh.fileno())
+
+    def close(self) -> None:
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None

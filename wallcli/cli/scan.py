@@ -1,0 +1,107 @@
+"""``wallcli scan INPUT... -o results.jsonl``: many videos, one decode each, on this machine or a
+Dask cluster, resumable."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+
+def scan(
+    inputs: List[str] = typer.Argument(..., help="Video files, folders (searched recursively, see --glob), http(s)/rtsp "
+                                       "URLs, or @list.txt (one path or URL a line, # comments).", show_default=False,
+                                       metavar="INPUT"),
+    output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see CONTRACT.md), "
+                                "or flattened CSV when the name ends in .csv. An existing file is resumed.",
+                                show_default=False),
+    task: str = typer.Option("count,activity,snr", "--task", help="Comma list of count, activity, snr: what each video is "
+                             "asked. All come from one decode of the video."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Worker processes on this machine (one core "
+                                          "each). Default: the number of cores."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run on an existing Dask cluster instead, e.g. "
+                                            "tcp://10.0.0.5:8786 (its workers need this wallcli version installed)."),
+    glob: Optional[List[str]] = typer.Option(None, "--glob", help="File names to take from folders, e.g. '*.mp4' "
+                                             "(repeatable). Default: the usual video extensions, any case."),
+    force: bool = typer.Option(False, "--force", help="Start the results file again (every video redone) instead of "
+                               "resuming it."),
+    windows: bool = typer.Option(False, "--windows", help="Keep every window's answer in count and activity "
+                                 "(the lines grow by a few hundred bytes per 2 s of video)."),
+    timeout: float = typer.Option(300.0, "--timeout", min=0.0, help="Give a video up (an error line) when its decoder "
+                                  "produces no frame for this many seconds. 0: wait forever."),
+    json_out: bool = typer.Option(False, "--json", help="Print the run's summary as one JSON object on stdout."),
+) -> None:
+    """Analyse many videos into one results file: one line per video, as each finishes.
+
+    Each video is decoded once; its frames feed the space-time plots (for count and activity)
+    and the SNR estimate together, and the answers equal those of 'wallcli count/activity/snr
+    --json' on that video. Videos run in parallel on a Dask LocalCluster of worker processes
+    on this machine, or on an existing Dask cluster (--scheduler). A video that cannot be read,
+    is too short, hangs its decoder (--timeout) or kills its worker twice gets a line with
+    "error" and the scan goes on.
+
+    Re-running the same command resumes: videos already in the output with the same sha256 and
+    tasks are skipped, failed ones are tried again; --force redoes everything. The exit code is
+    0 when every video has its line, failed or not: count failures in the summary (--json).
+
+    \b
+    Examples:
+      wallcli scan recordings/ -o results.jsonl
+      wallcli scan cam1/ cam2/ --glob '*.mkv' --task count,snr -o day.csv
+      wallcli scan @todo.txt -o results.jsonl --scheduler tcp://10.0.0.5:8786
+      jq -r 'select(.error == null) | [.input, .count.label] | @tsv' results.jsonl
+    """
+    import os
+
+    from wallcli.batch.scan import parse_tasks, run_scan
+    from wallcli.cli.output import emit_json, log, to_json
+
+    tasks = parse_tasks(task)
+    if workers is not None and scheduler is not None:
+        from wallcli.errors import UsageError
+
+        raise UsageError("--workers sizes the cluster on this machine; a --scheduler has its own workers")
+    debug = os.environ.get("WALLCLI_DEBUG", "") not in ("", "0")
+    state = {"hours": 0.0, "failed": 0}
+
+    def on_line(line: dict) -> None:
+        if line.get("error") is None:
+            state["hours"] += float(line.get("duration") or 0.0) / 3600.0
+        else:
+            state["failed"] += 1
+            # named as they happen: the bar only counts them
+            err = line["error"]
+            log(f"failed: {err}" if line["input"] in err else f"failed: {line['input']}: {err}", wrap=False)
+        bar.update(state["hours"], state["failed"])
+
+    with _Bar() as bar:
+        summary = run_scan(inputs, output, tasks=tasks, workers=workers, scheduler=scheduler, globs=glob,
+                           force=force, windows=windows, timeout=timeout, encode=to_json, log=lambda m: log(m, wrap=False),
+                           on_start=bar.start, on_line=on_line, debug=debug)
+    log(f"scan: {summary['videos']} videos: {summary['ok']} done, {summary['failed']} failed, "
+        f"{summary['skipped']} already done; {summary['hours']:.2f} h of video in {summary['seconds']:.1f} s "
+        f"({summary['videos_per_second']:.2f} videos/s) -> {summary['output']}", wrap=False)
+    if json_out:
+        emit_json(summary)
+
+
+class _Bar:
+    """The progress bar, opened once the number of videos to do is known."""
+
+    def __init__(self):
+        self._cm = None
+        self.update = lambda hours, failed: None
+
+    def start(self, todo: int, skipped: int) -> None:
+        from wallcli.cli.output import batch_progress
+
+        if todo:
+            self._cm = batch_progress("scan", todo)
+            self.update = self._cm.__enter__()
+
+    def __enter__(self) -> "_Bar":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._cm is not None:
+            self._cm.__exit__(*exc)
