@@ -58,6 +58,8 @@ def train(
     arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the seed's nets exactly (count reads the "
                              "horizontal plot, activity both); 'lite' = both plots for either task, time averaged in "
                              "pairs and 32 channels (about a quarter of the seed count net's work; wallcli/train/nets.py)."),
+    balance: bool = typer.Option(False, "--balance", help="Weight the loss by the inverse frequency of each class "
+                                 "among the training windows (rare classes count as much as common ones)."),
     calibrate: List[Path] = typer.Option([], "--calibrate", help="Simulated validation dataset(s) the net never trained "
                                          "on: fit the card's decided/undetermined thresholds there (per answer and band of "
                                          "measured signal; wallcli/infer/confidence.py). Without it, every answer of the "
@@ -141,7 +143,7 @@ def train(
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
                       min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
-                      anneal=anneal, init=init, lr=lr, arch=arch)
+                      anneal=anneal, init=init, lr=lr, arch=arch, balance=balance)
 
     # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1): wallcli.cli._signals,
     # installed by main(), turns both into wallcli.errors.Interrupted, which run_training catches.
@@ -169,7 +171,7 @@ def train(
         training={**({"init": init_info} if init_info else {}), "arch": arch, "seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
                   **({"lr_schedule": f"constant {cfg.lr:g}, then cosine to {cfg.lr * ANNEAL_FLOOR:g} over the last {anneal} epochs"}
                      if anneal else {}),
-                  "loss": "cross-entropy", "augmentation": ([SUPERPOSE_DESCRIPTION.format(p=superpose)] if superpose > 0 else [])
+                  "loss": "cross-entropy" + (", classes weighted by inverse training frequency" if balance else ""), "augmentation": ([SUPERPOSE_DESCRIPTION.format(p=superpose)] if superpose > 0 else [])
                   + (DESCRIPTION if augment else []),
                   "weight_average": {"ema_decay_per_step": ema, "exported": select},
                   "selected_epoch": result["best_epoch"], "history": result["history"],
@@ -185,6 +187,7 @@ def train(
                              + (f" --init {init}" if init is not None else "")
                              + (f" --preprocessing {preprocessing}" if preprocessing != "v1" else "")
                              + (f" --arch {arch}" if arch != "seed" else "")
+                             + (" --balance" if balance else "")
                              + "".join(f" --calibrate {c}" for c in calibrate)
                              + (f" --confidence-level {confidence_level:g}" if calibrate else "")},
         validation=validation,

@@ -125,6 +125,19 @@ class ShardDataset:
         k = int(np.searchsorted(np.cumsum([len(m["shards"]) for m in self.manifests]), shard, side="right"))
         return self.relabel[k]
 
+    def labels(self) -> np.ndarray:
+        """Every window's label, as training sees it (relabelled where the dataset is)."""
+        import zipfile
+
+        out = np.zeros(self.n, np.int64)
+        for i, f in enumerate(self.files):
+            try:
+                with np.load(f, allow_pickle=False) as npz:
+                    out[self.offsets[i]:self.offsets[i + 1]] = npz["activity" if self._relabelled(i) else "label"]
+            except (OSError, ValueError, KeyError, zipfile.BadZipFile) as e:
+                raise WallcliError(f"{f} is not a readable shard ({e})") from None
+        return out
+
     def usable(self, indices: np.ndarray) -> np.ndarray:
         """``indices`` without windows this task cannot use: from a relabelled count dataset,
         those with two movers (an activity net answers for one person)."""

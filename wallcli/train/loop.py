@@ -82,6 +82,7 @@ class TrainConfig:
     preprocessing: str = NORMALIZATION  # which normalize_window the net is trained on (the card records it)
     init: Path | None = None  # an exported model (.onnx) whose weights training starts from
     arch: str = "seed"  # wallcli.train.nets.ARCHS
+    balance: bool = False  # weight the loss by inverse class frequency of the training windows
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
@@ -142,6 +143,7 @@ def _identity(cfg: TrainConfig, ds: ShardDataset) -> dict[str, Any]:
             "superpose": cfg.superpose, "seed": cfg.seed, "batch_size": cfg.batch_size, "min_snr_db": cfg.min_snr_db, "val_fraction": cfg.val_fraction if cfg.val is None else None,
             **({} if cfg.preprocessing == NORMALIZATION else {"preprocessing": cfg.preprocessing}),
             **({} if cfg.arch == "seed" else {"arch": cfg.arch}),
+            **({"balance": True} if cfg.balance else {}),
             **({} if cfg.init is None else {"init": sha256_file(Path(cfg.init))}),
             **({} if cfg.lr == 1e-3 else {"lr": cfg.lr})}
 
@@ -177,7 +179,13 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
     if cfg.channels_last:
         net = net.to(memory_format=torch.channels_last)
     opt = torch.optim.RMSprop(net.parameters(), lr=cfg.lr)
-    loss_fn = nn.CrossEntropyLoss()
+    weight = None
+    if cfg.balance:
+        # a rare class (waving, jumping: few of them visible) must not be traded for the common one
+        counts = np.bincount(ds.labels()[train_idx], minlength=len(ds.classes)).astype(np.float64)
+        weight = torch.tensor(np.where(counts > 0, counts.sum() / (len(counts) * np.maximum(counts, 1)), 0.0),
+                              dtype=torch.float32)
+    loss_fn = nn.CrossEntropyLoss(weight=weight)
     ident = _identity(cfg, ds)
     epoch, start_batch, history, step = 0, 0, [], 0
     ema = {k: v.detach().clone() for k, v in net.state_dict().items()} if cfg.ema > 0 else None
