@@ -12,8 +12,8 @@ cd "$(dirname "$0")/.."
 W=${WALLCLI:-.venv/bin/wallcli}
 PY=${PYTHON:-.venv/bin/python}
 JOBS=${JOBS:-2}
-EPOCHS=${EPOCHS:-8}
-WIDE=${WIDE:-3968}  # windows of the training set (31 shards of 32 scenes x 4 windows)
+EPOCHS=${EPOCHS:-10}
+WIDE=${WIDE:-4864}  # windows of the training set (38 shards of 32 scenes x 4 windows)
 
 # One 'wide' count dataset serves both nets: its scenes hold 0-2 movers of every activity (and a
 # third of the empty rooms someone standing still); the activity net learns from its windows with
@@ -25,7 +25,7 @@ for task in count activity; do
   extra=""
   [ "$task" = count ] && extra="--superpose 0.2"
   $W train "$task" --data data/wide21 --val data/val_wide22 --out "models/$task.onnx" --arch lite \
-    --epochs "$EPOCHS" --min-snr-db -10 --select last $extra --threads 1 \
+    --epochs "$EPOCHS" --anneal 3 --min-snr-db -20 --balance --select last $extra --threads 1 \
     --calibrate data/val_wide22 --confidence-level 0.97 --model-version 0.5.0 --force
 done
 
