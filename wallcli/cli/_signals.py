@@ -1,20 +1,37 @@
 """Ctrl-C (SIGINT) and `kill PID` (SIGTERM) unwind the same way: temporary outputs are removed, a
 training run saves its checkpoint, and the command exits 1 with `Error: interrupted`. SIGTERM's
 default action would end the process on the spot and leave `.NAME.XXXX.tmp.EXT` behind; Python's
-own SIGINT handler raises a bare KeyboardInterrupt (see wallcli.errors.Interrupted for why not)."""
+own SIGINT handler raises a bare KeyboardInterrupt (see wallcli.errors.Interrupted for why not).
+
+The first signal raises; later ones only set the flag, so a second Ctrl-C cannot break the clean-up
+the first one started, nor land in main()'s own error handling. Once main() has settled the exit
+code, :func:`settle` ignores both signals: a signal during the interpreter's shut-down would
+otherwise end the process by the signal itself (exit 130, no message), as Python restores the
+default handlers before it exits."""
 from __future__ import annotations
 
+_raised = False
 
-def install() -> None:
+
+def install():
+    """Install the handlers; returns what they replaced, for :func:`restore`."""
     import signal
     import sys
     import threading
 
+    from wallcli import errors
     from wallcli.errors import Interrupted, mark_interrupted
 
+    global _raised
+    _raised = False
+    errors._interrupted = False  # main() run again in one process (tests) starts afresh
+
     def handler(signum, frame):
+        global _raised
         mark_interrupted()  # in case the raise below lands where Python swallows it
-        raise Interrupted
+        if not _raised:
+            _raised = True
+            raise Interrupted
 
     previous = sys.unraisablehook
 
@@ -27,8 +44,37 @@ def install() -> None:
     unraisable.wallcli = True
     if not getattr(previous, "wallcli", False):  # main() called again in one process: wrap once
         sys.unraisablehook = unraisable
+    saved = {}
     if threading.current_thread() is threading.main_thread():
+        saved = {signal.SIGTERM: signal.getsignal(signal.SIGTERM), signal.SIGINT: signal.getsignal(signal.SIGINT)}
         signal.signal(signal.SIGTERM, handler)
         # a shell starts background jobs with SIGINT ignored: leave that as it is
         if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
             signal.signal(signal.SIGINT, handler)
+    return saved
+
+
+def settle() -> None:
+    """The exit code is decided: from now on SIGINT and SIGTERM are ignored (process-wide, and
+    Python leaves ignored signals ignored through its shut-down)."""
+    import signal
+    import threading
+
+    global _raised
+    _raised = True  # a signal already caught but not yet handled must not raise either
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
+
+
+def restore(saved) -> None:
+    """main() called from Python (tests): give the caller its own handlers back."""
+    import signal
+    import threading
+
+    global _raised
+    _raised = True
+    if threading.current_thread() is threading.main_thread():
+        for sig, handler in (saved or {}).items():
+            if handler is not None:
+                signal.signal(sig, handler)
