@@ -23,6 +23,8 @@ def install():
     from wallcli.errors import Interrupted, mark_interrupted
 
     global _raised
+    if threading.current_thread() is threading.main_thread() and getattr(signal.getsignal(signal.SIGTERM), "wallcli", False):
+        return {}  # already installed (by the console script, before its imports): keep its state
     _raised = False
     errors._interrupted = False  # main() run again in one process (tests) starts afresh
 
@@ -33,6 +35,7 @@ def install():
             _raised = True
             raise Interrupted
 
+    handler.wallcli = True
     previous = sys.unraisablehook
 
     def unraisable(info):

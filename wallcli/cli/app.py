@@ -74,9 +74,11 @@ def _debug() -> bool:
 
 def _say(message: str) -> None:
     # One line on stderr, always: scripts grep for it and humans read it (stderr may be closed: 2>&-)
+    from wallcli.cli.output import printable
+
     if sys.stderr is not None:
         try:
-            sys.stderr.write(f"Error: {' '.join(str(message).split())}\n")
+            sys.stderr.write(f"Error: {printable(' '.join(str(message).split()))}\n")
             sys.stderr.flush()
         except (OSError, ValueError):
             pass
@@ -127,7 +129,7 @@ def main(argv: list[str] | None = None) -> None:
 
 def _run(argv: list[str] | None) -> int:
     """Run the command; print its error line; return the exit code."""
-    from wallcli.cli.output import StdoutError, abandon_stdout, guarded_stdout
+    from wallcli.cli.output import StdoutError, abandon_stdout, guarded_stdout, printable
     from wallcli.errors import WallcliError, raise_if_interrupted
 
     Abort, ClickException, Exit, ClickUsageError = _click_exceptions()
@@ -136,7 +138,7 @@ def _run(argv: list[str] | None) -> int:
 
     def _show(message, category, *args, **kwargs):  # warnings: one line on stderr, no source line
         if sys.stderr is not None:
-            sys.stderr.write(f"Warning: {message}\n")
+            sys.stderr.write(f"Warning: {printable(message)}\n")
 
     warnings.showwarning = _show
     if argv is None:

@@ -115,13 +115,14 @@ def simulate(
     if domain not in ("base", "shifted"):
         raise UsageError(f"--domain must be base or shifted (got {domain!r})")
     grid_rc = _size(grid, "--grid", 512) if grid else ((24, 32) if dataset is not None else (64, 64))
+    # checked in both modes, so that a mistyped value is never silently ignored
+    if task not in ("count", "activity"):
+        raise UsageError(f"--task must be count or activity (got {task!r})")
+    if placement not in ("visible", "anywhere"):
+        raise UsageError(f"--placement must be visible or anywhere (got {placement!r})")
     if dataset is not None:
-        if task not in ("count", "activity"):
-            raise UsageError(f"--task must be count or activity (got {task!r})")
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
-        if placement not in ("visible", "anywhere"):
-            raise UsageError(f"--placement must be visible or anywhere (got {placement!r})")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
                         json_out, placement)
     if world == "mixed":

@@ -96,6 +96,8 @@ def snr(
     if heatmap_of not in ("signal", "snr"):
         raise UsageError(f"--heatmap-of must be signal or snr (got {heatmap_of!r})")
     if predict_mode:
+        if roi is not None or heatmap is not None:
+            raise UsageError("--roi and --heatmap measure a video; --predict reads none")
         params = {k: v for k, v in locals().items() if k in PREDICT_PARAMS}
         with committed_together():  # the figure and the data on stdout: all or none
             return _predict(params, approx=approx, sweep=sweep, plot=plot, json_out=json_out, force=force)
