@@ -52,6 +52,7 @@ BASES = {
     "activity": [["{plot}", "--json"], ["{clip}"]],
     "simulate": [["-o", "out.y4m", "--size", "16x16", "--duration", "0.2", "--fps", "15", "--grid", "4x4"]],
     "train": [["count", "--data", "nodata", "--out", "out.onnx"]],
+    "evaluate": [["{labelled}", "--task", "count", "--json", "--jobs", "1"]],
 }
 
 
@@ -167,7 +168,12 @@ def inputs(tmp_path_factory):
                       + np.random.default_rng(i).normal(0, 1.0, (24, 32, 3)), 12, fps=30, codec="ffv1",
                       pix_fmt="bgr0", options={})
     plot = write_plot(folder / "p.npz")
-    return folder, {"clip": str(clip), "plot": str(plot), "input": str(clip)}
+    labelled = folder / "labelled"  # a folder of clips with labels (wallcli evaluate)
+    labelled.mkdir()
+    write_clip(labelled / "long.mkv", lambda i: np.full((24, 32, 3), 120.0), 270, fps=30, codec="ffv1",
+               pix_fmt="bgr0", options={})
+    (labelled / "labels.csv").write_text("file,people,activity\nlong.mkv,0,none\n")
+    return folder, {"clip": str(clip), "plot": str(plot), "input": str(clip), "labelled": str(labelled)}
 
 
 def _run_in_process(argv, capsys):

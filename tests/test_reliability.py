@@ -221,8 +221,8 @@ def test_bad_card_through_the_cli_and_new_fields_are_welcome(tmp_path, run_cli):
     model = _model_with(tmp_path, fps=0)
     code, out, err = run_cli("count", plot, "--model", model, "--json")
     assert code == 1 and out == "" and "'fps'" in _one_error(err)
-    # fields a newer model owner adds (a transfer block, confidence thresholds) are not refused
-    model = _model_with(tmp_path, transfer={"accuracy": 0.8, "renderer": "other"}, confidence={"min_probability": 0.6})
+    # fields a newer model owner adds (a transfer block, anything not read yet) are not refused
+    model = _model_with(tmp_path, transfer={"accuracy": 0.8, "renderer": "other"}, owner_notes={"x": [1, None]})
     code, out, err = run_cli("count", plot, "--model", model, "--json")
     assert code == 0, err
     assert json.loads(out)["model"]["name"] == "wallcli-count"
