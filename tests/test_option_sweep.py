@@ -53,6 +53,8 @@ BASES = {
     "simulate": [["-o", "out.y4m", "--size", "16x16", "--duration", "0.2", "--fps", "15", "--grid", "4x4"]],
     "train": [["count", "--data", "nodata", "--out", "out.onnx"]],
     "evaluate": [["{labelled}", "--task", "count", "--json", "--jobs", "1"]],
+    "scan": [["{clip}", "-o", "out.jsonl", "--workers", "1", "--task", "snr"]],
+    "report": [["{clip}", "-o", "out.html"]],
 }
 
 
