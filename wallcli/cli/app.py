@@ -85,12 +85,13 @@ def _say(message: str) -> None:
 
 
 def _click_exceptions():
-    # typer >= 0.16 vendors click as typer._click; older ones depend on click itself.
+    # typer >= 0.16 vendors click as typer._click; older ones depend on click itself. The vendored
+    # one first: click may be installed beside it (dask needs it), but typer raises its own.
     try:
-        from click.exceptions import Abort, ClickException, Exit, UsageError
-    except ImportError:
         from typer._click.exceptions import ClickException, UsageError
         from typer.exceptions import Abort, Exit
+    except ImportError:
+        from click.exceptions import Abort, ClickException, Exit, UsageError
     return Abort, ClickException, Exit, UsageError
 
 
