@@ -64,3 +64,16 @@ def write_clip(
             for p in a.encode():
                 c.mux(p)
     return Path(path)
+
+
+def write_plot(path: Path, seconds: float = 9.0, fps: float = 30.0, bins: int = 64, seed: int = 0) -> Path:
+    """A space-time plot file as ``wallcli stplot -o`` writes it (noise), long enough for one window."""
+    from wallcli.io.arrays import save_npz
+    from wallcli.signal.stplot import FORMAT
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(round(fps * seconds))) / fps
+    h, v = (rng.normal(0, 0.05, (bins, t.size, 3)).astype(np.float32) for _ in range(2))
+    save_npz(path, {"horizontal": h, "vertical": v, "time": t},
+             {"format": FORMAT, "format_version": 1, "bins": bins, "fps": fps, "roi": [0, 0, 64, 48]})
+    return Path(path)

@@ -1,4 +1,4 @@
-from wallcli.cli.app import main
+from wallcli.cli.entry import main
 
 if __name__ == "__main__":
     main()

@@ -93,6 +93,7 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
         log(f"{skipped} of {len(sources)} videos already in {out} (same sha256 and tasks): skipped; --force redoes them")
     on_start(len(todo), skipped)
     config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity())
+    existed = out.exists()
     results = ResultsFile(out, encode, columns)
     results.start(kept)
     ok = failed = 0
@@ -119,8 +120,12 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
                     else:
                         failed += 1
                     on_line(line)
-    finally:
+    except BaseException:
         results.close()
+        if not existed and ok + failed == 0:  # a run that failed before its first line leaves no file
+            out.unlink(missing_ok=True)
+        raise
+    results.close()
     wall = time.perf_counter() - t0
     return {
         "output": str(out),

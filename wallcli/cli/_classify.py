@@ -10,15 +10,16 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, input_argument, parse_roi
+from wallcli.cli.common import ROI_HELP, input_argument, number_option, parse_roi, threads_option
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
-STRIDE_OPT = typer.Option(None, "--stride", min=1, help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
+STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
+                           help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
 JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see CONTRACT.md).")
 PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
                         "(for a video, the plot drawn is averaged down to at most 2048 time columns).")
 MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
-THREADS_OPT = typer.Option(0, "--threads", min=0, help="onnxruntime intra-op threads (0: onnxruntime chooses).")
+THREADS_OPT = threads_option("onnxruntime intra-op threads (0: onnxruntime chooses).")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
 FORCE_OPT = typer.Option(False, "--force", help="Overwrite the --plot file.")
@@ -35,9 +36,9 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     if follow and str(input).lower().endswith(".npz"):
         raise UsageError("--follow reads live video; a .npz space-time plot is already complete")
 
-    from wallcli.cli.output import emit_json, print_table, progress
+    from wallcli.cli.output import emit_json, progress
     from wallcli.infer.model import load_model
-    from wallcli.io.writer import check_outputs
+    from wallcli.io.writer import check_outputs, committed_together
 
     # the model is an input too: --plot over it must not replace it
     check_outputs([plot], force=force, inputs=[input, model_path])
@@ -62,6 +63,13 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         with progress(task, None) as advance:
             result, st = classify_video(model, input, stride=stride, roi=roi_t,
                                         progress=advance, keep_plot=plot is not None)
+    with committed_together():  # the figure and the data on stdout: all or none
+        _report(task, input, model, result, st, plot, json_out, force)
+
+
+def _report(task, input, model, result, st, plot, json_out, force) -> None:
+    from wallcli.cli.output import emit_json, print_table
+
     if plot is not None:
         from wallcli.plots.timeline import save_timeline_png
 

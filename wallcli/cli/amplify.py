@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, parse_roi
+from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, number_option, parse_roi, threads_option
 
 VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # Frames held back while the automatic gain calibrates are kept whole only with --side-by-side
@@ -38,26 +38,26 @@ def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
 def amplify(
     input: str = input_argument(),
     output: Path = typer.Argument(..., help="Output video (.mp4, .mov, .m4v or .mkv; H.264).", show_default=False),
-    gain: Optional[float] = typer.Option(None, "--gain", min=0.0, help="Display levels per code value of signal "
+    gain: Optional[float] = number_option(None, "--gain", lo=0, hi=1e8, lo_open=True, help="Display levels per code value of signal "
                                          "(output = 128 + gain x signal). Default: automatic, +-3 robust sigma of "
                                          "the first --gain-seconds fill the range, then fixed."),
-    gain_seconds: float = typer.Option(2.0, "--gain-seconds", min=0.05, help="Video used to measure the automatic gain "
+    gain_seconds: float = number_option(2.0, "--gain-seconds", lo=0.05, hi=600, help="Video used to measure the automatic gain "
                                        "(those frames are written once it is known)."),
-    cells: int = typer.Option(64, "--cells", min=1, max=4096, help="Blocks along the longer side of the ROI; each "
+    cells: int = number_option(64, "--cells", lo=1, hi=4096, integer=True, help="Blocks along the longer side of the ROI; each "
                               "block is averaged exactly (noise falls as 1/sqrt(pixels)). Fewer = less noise, coarser."),
     mean: str = typer.Option("ema", "--mean", help="Running temporal mean removed per block: 'ema' (exponential) "
                              "or 'window' (trailing moving average). Both start as an expanding average."),
-    mean_seconds: float = typer.Option(10.0, "--mean-seconds", min=0.01, help="Time constant of 'ema' / span of 'window'."),
-    smooth: float = typer.Option(0.0, "--smooth", min=0.0, help="Temporal smoothing time constant in seconds "
+    mean_seconds: float = number_option(10.0, "--mean-seconds", lo=0.01, hi=3600, help="Time constant of 'ema' / span of 'window'."),
+    smooth: float = number_option(0.0, "--smooth", lo=0, hi=3600, help="Temporal smoothing time constant in seconds "
                                  "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion."),
     scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5) or WIDTHxHEIGHT."),
     side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Output shows the ROI only."),
-    crf: int = typer.Option(18, "--crf", min=0, max=51, help="H.264 quality (lower = better, bigger)."),
+    crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),
     preset: str = typer.Option("superfast", "--preset", help="x264 speed preset, ultrafast ... veryslow. superfast: 2x faster than veryfast, same size here; ultrafast: 2x faster again, 2x bigger."),
     json_out: bool = typer.Option(False, "--json", help="Print a summary (gain, frames, fps, size) as JSON on stdout."),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+    threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Make the invisible visible: a video of the wall's tiny light changes, amplified.
 
@@ -82,6 +82,16 @@ def amplify(
         raise UsageError(f"OUTPUT must end in {', '.join(VIDEO_SUFFIXES)} (got {output})")
     roi_t = parse_roi(roi)
 
+    from wallcli.io.writer import check_output, committed_together
+
+    check_output(output, force=force, inputs=[input])
+    with committed_together():  # the video and the JSON summary: both or neither
+        _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
+                preset, json_out, force, threads)
+
+
+def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
+            preset, json_out, force, threads) -> None:
     import itertools
 
     import numpy as np
@@ -89,11 +99,10 @@ def amplify(
     from wallcli.cli.output import console_err, emit_json, progress
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
-    from wallcli.io.writer import VideoWriter, atomic_path, check_output
+    from wallcli.io.writer import VideoWriter, atomic_path
     from wallcli.signal.amplify import Amplifier, grid_shape, original_panel, quantisation_sigma, render_panel
     from wallcli.signal.blocks import check_roi, rgb_grid
 
-    check_output(output, force=force, inputs=[input])
     with open_video(input, threads=threads) as reader:
         info = reader.info
         frames_in = reader.frames()

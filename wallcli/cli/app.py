@@ -73,12 +73,16 @@ def _debug() -> bool:
     return os.environ.get("WALLCLI_DEBUG", "") not in ("", "0")
 
 
-def _fail(message: str, code: int) -> None:
-    # One line on stderr, always: scripts grep for it and humans read it.
-    message = " ".join(str(message).split())
-    sys.stderr.write(f"Error: {message}\n")
-    sys.stderr.flush()
-    sys.exit(code)
+def _say(message: str) -> None:
+    # One line on stderr, always: scripts grep for it and humans read it (stderr may be closed: 2>&-)
+    from wallcli.cli.output import printable
+
+    if sys.stderr is not None:
+        try:
+            sys.stderr.write(f"Error: {printable(' '.join(str(message).split()))}\n")
+            sys.stderr.flush()
+        except (OSError, ValueError):
+            pass
 
 
 def _click_exceptions():
@@ -92,7 +96,42 @@ def _click_exceptions():
     return Abort, ClickException, Exit, UsageError
 
 
+def _fill_closed_fds() -> None:
+    """A standard stream closed by the caller (`>&-`) leaves its fd free, and the next file we open
+    would get it: FFmpeg's or a library's writes to 'stdout' would then land in our output file.
+    Park /dev/null there (Python already set sys.stdout to None, so our own data still fails)."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            null = os.open(os.devnull, os.O_RDWR)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+
+
 def main(argv: list[str] | None = None) -> None:
+    """The console script (``argv`` None) or a call from Python with ``argv``; ends with SystemExit
+    and a code of 0, 1 or 2, whatever happens, a signal during shut-down included."""
+    from wallcli.cli import _signals
+
+    saved = _signals.install()
+    try:
+        code = _run(argv)
+    except KeyboardInterrupt:  # the one signal that raises (see _signals) landed after _run decided
+        _say("interrupted")
+        code = 1
+    finally:
+        if argv is None:
+            _signals.settle()
+        else:
+            _signals.restore(saved)
+    sys.exit(code)
+
+
+def _run(argv: list[str] | None) -> int:
+    """Run the command; print its error line; return the exit code."""
+    from wallcli.cli.output import StdoutError, abandon_stdout, guarded_stdout, printable
     from wallcli.errors import WallcliError, raise_if_interrupted
 
     Abort, ClickException, Exit, ClickUsageError = _click_exceptions()
@@ -100,55 +139,70 @@ def main(argv: list[str] | None = None) -> None:
     import warnings
 
     def _show(message, category, *args, **kwargs):  # warnings: one line on stderr, no source line
-        sys.stderr.write(f"Warning: {message}\n")
+        if sys.stderr is not None:
+            sys.stderr.write(f"Warning: {printable(message)}\n")
 
     warnings.showwarning = _show
-    from wallcli.cli import _signals
-
-    _signals.install()
+    if argv is None:
+        _fill_closed_fds()
     command = typer.main.get_command(app)
     try:
-        rv = command.main(args=argv, prog_name="wallcli", standalone_mode=False)
-        raise_if_interrupted()  # killed, but the exception was swallowed on the way: still exit 1
+        with guarded_stdout():
+            rv = command.main(args=argv, prog_name="wallcli", standalone_mode=False)
+            raise_if_interrupted()  # killed, but the exception was swallowed on the way: still exit 1
         # Without standalone mode, click *returns* the code of an Exit it caught (Ctrl-C -> 130);
         # the contract knows 0, 1 and 2 only: an interrupted job is work that failed (1).
         if isinstance(rv, int) and rv:
             if rv == 130:
-                _fail("interrupted", 1)
-            sys.exit(rv)
+                _say("interrupted")
+                return 1
+            return rv if rv in (1, 2) else 1
+        return 0
+    except StdoutError as exc:
+        abandon_stdout()
+        _say(str(exc))
+        return 1
     except WallcliError as exc:
         if _debug():
             raise
-        _fail(str(exc), exc.exit_code)
+        _say(str(exc))
+        return exc.exit_code
     except Exit as exc:
-        sys.exit(exc.exit_code)
+        return exc.exit_code if exc.exit_code in (0, 1, 2) else 1
     except Abort:
-        _fail("interrupted", 1)
+        _say("interrupted")
+        return 1
     except ClickUsageError as exc:
         if _debug():
             raise
         if type(exc).__name__ == "NoArgsIsHelpError":  # bare `wallcli` / `wallcli CMD`: show help
-            sys.stderr.write(exc.ctx.get_help() + "\n" if exc.ctx else "")
-            sys.exit(2)
+            if sys.stderr is not None:
+                sys.stderr.write(exc.ctx.get_help() + "\n" if exc.ctx else "")
+            return 2
         path = exc.ctx.command_path if exc.ctx else "wallcli"
-        _fail(f"{exc.format_message()} (see '{path} --help')", 2)
+        _say(f"{exc.format_message()} (see '{path} --help')")
+        return 2
     except ClickException as exc:
         if _debug():
             raise
-        _fail(exc.format_message(), exc.exit_code or 1)
+        _say(exc.format_message())
+        return exc.exit_code if exc.exit_code in (1, 2) else 1
     except KeyboardInterrupt:
         if _debug():
             raise
-        _fail("interrupted", 1)
+        _say("interrupted")
+        return 1
     except BrokenPipeError:
-        # `wallcli ... | head`: the reader left; not our failure.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        sys.exit(1)
+        # `wallcli ... | head`: the reader left; not our failure, and nothing to tell it.
+        abandon_stdout()
+        return 1
     except MemoryError:
         if _debug():
             raise
-        _fail("out of memory", 1)
+        _say("out of memory")
+        return 1
     except Exception as exc:  # noqa: BLE001 - the last line of defence keeps the one-line promise
         if _debug():
             raise
-        _fail(f"internal error: {type(exc).__name__}: {exc} (set WALLCLI_DEBUG=1 for a traceback and report it)", 1)
+        _say(f"internal error: {type(exc).__name__}: {exc} (set WALLCLI_DEBUG=1 for a traceback and report it)")
+        return 1

@@ -2,12 +2,89 @@
 
 from __future__ import annotations
 
+import math
+import os
+
 import typer
 
 from wallcli.errors import UsageError
 
 ROI_HELP = "Region of the wall to analyse, x,y,w,h in source pixels (origin top-left). Default: whole frame."
 FORCE_HELP = "Overwrite existing output files."
+# More threads than this only adds contention; 100000 of them once took 16 GB and ignored SIGTERM.
+MAX_THREADS = 4 * (os.cpu_count() or 1)
+
+
+def _fmt(x: float) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+class Number:
+    """The parser (typer ``parser=``) of every numeric option: a finite number within its range.
+
+    NaN, +-inf, out-of-range and malformed values are usage errors (exit 2) that name the option,
+    before any work starts. One class for all of them, so a new option cannot forget a check;
+    tests/test_option_sweep.py insists that every int or float option uses it.
+    """
+
+    def __init__(self, flag: str, lo: float, hi: float, *, integer: bool = False,
+                 lo_open: bool = False, hi_open: bool = False) -> None:
+        self.flag, self.lo, self.hi, self.integer = flag, lo, hi, integer
+        self.lo_open, self.hi_open = lo_open, hi_open
+
+    def range_text(self) -> str:
+        if not (self.lo_open or self.hi_open):
+            return f"from {_fmt(self.lo)} to {_fmt(self.hi)}"
+        lo = f"{'more than' if self.lo_open else 'from'} {_fmt(self.lo)}"
+        hi = f"{'less than' if self.hi_open else 'up to'} {_fmt(self.hi)}"
+        return f"{lo}, {hi}"
+
+    def describe(self) -> str:
+        return f"{'an integer' if self.integer else 'a number'} {self.range_text()}"
+
+    def __call__(self, value):
+        # typer passes the default through too, as a number
+        if isinstance(value, bool):
+            raise UsageError(f"{self.flag} must be {self.describe()} (got {value!r})")
+        if isinstance(value, (int, float)):
+            x, shown = value, _fmt(value)
+        else:
+            shown = str(value)
+            text = shown.strip()
+            try:
+                x = int(text, 10) if self.integer else float(text)
+            except ValueError:  # also int() of more than 4300 digits
+                x = None
+            if x is None or (not self.integer and not text):
+                raise UsageError(f"{self.flag} must be {self.describe()} (got {shown!r})") from None
+        if self.integer and isinstance(x, float):
+            if not x.is_integer():
+                raise UsageError(f"{self.flag} must be {self.describe()} (got {shown})")
+            x = int(x)
+        if not self.integer and not math.isfinite(x):
+            raise UsageError(f"{self.flag} must be {self.describe()} (got {shown})")
+        below = x <= self.lo if self.lo_open else x < self.lo
+        above = x >= self.hi if self.hi_open else x > self.hi
+        if below or above:
+            raise UsageError(f"{self.flag} must be {self.describe()} (got {shown})")
+        return int(x) if self.integer else float(x)
+
+
+def number_option(default, flag: str, *aliases: str, lo: float, hi: float, integer: bool = False,
+                  lo_open: bool = False, hi_open: bool = False, help: str = "", **kwargs):
+    """A ``typer.Option`` for a number, checked by :class:`Number`; its range is added to the help."""
+    parse = Number(flag, lo, hi, integer=integer, lo_open=lo_open, hi_open=hi_open)
+    text = f"{help} [{'integer' if integer else 'number'} {parse.range_text()}]".strip()
+    return typer.Option(default, flag, *aliases, parser=parse, metavar="INTEGER" if integer else "NUMBER",
+                        help=text, **kwargs)
+
+
+def threads_option(help: str):
+    """``--threads``, 0 (the library chooses) up to 4 threads per CPU core."""
+    return number_option(0, "--threads", lo=0, hi=MAX_THREADS, integer=True,
+                         help=f"{help} At most 4 per CPU core ({MAX_THREADS} on this machine).")
+
+
 THREADS_HELP = "Decoder threads (0 = FFmpeg chooses)."
 
 

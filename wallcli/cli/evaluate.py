@@ -6,7 +6,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP
+from wallcli.cli.common import FORCE_HELP, MAX_THREADS, ROI_HELP, number_option
 
 
 def evaluate(
@@ -20,7 +20,8 @@ def evaluate(
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw a reliability diagram (confidence of the clip "
                                         "answers against how often they are right) and accuracy against measured "
                                         "SNR to this PNG."),
-    jobs: int = typer.Option(0, "--jobs", "-j", min=0, help="Clips analysed at once, one process each (0 = one per core)."),
+    jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
+                              help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
 ) -> None:

@@ -4,14 +4,21 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import re
 import sys
 from contextlib import contextmanager
 from typing import Any, Iterator
 
 from rich.console import Console
 
-console_err = Console(stderr=True, highlight=False)
-console_out = Console(highlight=False)
+from wallcli.errors import WallcliError
+
+# markup off: a file named '[/x].mp4' is text, not a (broken) style tag
+console_err = Console(stderr=True, highlight=False, markup=False)
+console_out = Console(highlight=False, markup=False)
+# A file name that is not valid UTF-8 reaches Python as str with lone surrogates (PEP 383).
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _clean(obj: Any) -> Any:
@@ -28,7 +35,20 @@ def _clean(obj: Any) -> Any:
 
 
 def to_json(obj: Any) -> str:
-    return json.dumps(_clean(obj), ensure_ascii=False, allow_nan=False)
+    """Valid JSON whatever the strings hold: lone surrogates (the undecodable bytes of a file name
+    that is not UTF-8) are written as \\udcXX escapes, which json.loads turns back into the same
+    str (os.fsencode of it gives the original bytes); raw, they would put invalid UTF-8 on stdout."""
+    text = json.dumps(_clean(obj), ensure_ascii=False, allow_nan=False)
+    return _SURROGATE.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
+
+
+def printable(text: Any) -> str:
+    """``text`` for a terminal: an undecodable byte of a file name shown as \\xff."""
+    def escape(m: re.Match) -> str:
+        c = ord(m.group())
+        return f"\\x{c - 0xDC00:02x}" if 0xDC80 <= c <= 0xDCFF else f"\\u{c:04x}"
+
+    return _SURROGATE.sub(escape, str(text))
 
 
 def emit_json(obj: Any) -> None:
@@ -40,25 +60,95 @@ def emit_json(obj: Any) -> None:
 def log(message: str, *, wrap: bool = True) -> None:
     """A line for the reader on stderr; ``wrap=False`` for lines that name files (no break inside
     a path, so grep finds it)."""
-    console_err.print(message, soft_wrap=not wrap)
+    console_err.print(printable(message), soft_wrap=not wrap)
 
 
 def warn(message: str) -> None:
-    from rich.markup import escape
+    from rich.text import Text
 
-    # messages carry file names, which may hold '[...]' (rich markup) of any kind
-    console_err.print(f"[yellow]Warning:[/yellow] {escape(message)}", markup=True)
+    console_err.print(Text.assemble(("Warning:", "yellow"), " ", printable(message)))
 
 
 def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
     from rich.table import Table
 
-    table = Table(title=title, title_justify="left")
+    table = Table(title=printable(title), title_justify="left")
     for i, col in enumerate(columns):
-        table.add_column(col, justify="left" if i == 0 else "right")
+        table.add_column(printable(col), justify="left" if i == 0 else "right")
     for row in rows:
-        table.add_row(*(str(c) for c in row))
+        table.add_row(*(printable(c) for c in row))
     console_out.print(table)
+
+
+# --------------------------------------------------------------------------------------- stdout
+class StdoutError(WallcliError):
+    """stdout cannot take the data: the user's environment (a full disk, a closed stdout), not a bug."""
+
+
+def _reason(exc: BaseException | None) -> str:
+    if isinstance(exc, OSError) and exc.errno:
+        text = os.strerror(exc.errno)
+        return text[:1].lower() + text[1:]
+    return "it is closed"
+
+
+class _GuardedStdout:
+    """sys.stdout while a command runs: a failed write or flush raises :class:`StdoutError`
+    (one error line, exit 1) wherever it happens (our JSON and tables, click's help, print);
+    a reader that went away (BrokenPipeError) is left to main(), which ends quietly."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def _call(self, name: str, *args):
+        if self._stream is None:  # started with stdout closed (`>&-`): Python sets sys.stdout to None
+            raise StdoutError(f"cannot write to stdout: {_reason(None)}")
+        try:
+            return getattr(self._stream, name)(*args)
+        except BrokenPipeError:
+            raise
+        except UnicodeError:
+            raise
+        except (OSError, ValueError) as exc:  # ValueError: write to a closed file
+            raise StdoutError(f"cannot write to stdout: {_reason(exc)}") from None
+
+    def write(self, text: str) -> int:
+        return self._call("write", text)
+
+    def flush(self) -> None:
+        self._call("flush")
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def guarded_stdout() -> Iterator[None]:
+    """Run a command with sys.stdout guarded; data still buffered is flushed at the end, inside,
+    so that its failure is reported like any other."""
+    real = sys.stdout
+    sys.stdout = _GuardedStdout(real)
+    try:
+        yield
+        sys.stdout.flush()
+    finally:
+        sys.stdout = real
+
+
+def abandon_stdout() -> None:
+    """After stdout failed: point the process's fd 1 at /dev/null, so that the interpreter's last
+    flush of what is still buffered does not print a traceback and exit 120. Only for the real
+    stdout (not a test's capture)."""
+    stream = sys.stdout
+    if stream is None or stream is not sys.__stdout__:
+        return
+    try:
+        fd = stream.fileno()
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, fd)
+        os.close(null)
+    except (OSError, ValueError):
+        pass
 
 
 @contextmanager

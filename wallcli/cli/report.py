@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, parse_roi
+from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, parse_roi, threads_option
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
 
@@ -20,7 +20,7 @@ def report(
     count_model: Optional[Path] = typer.Option(None, "--count-model", help="Your own count .onnx (its card beside it). Default: the shipped model."),
     activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+    threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Write one HTML page that opens offline in any browser and can be handed over as it is.
 

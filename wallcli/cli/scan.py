@@ -7,6 +7,8 @@ from typing import List, Optional
 
 import typer
 
+from wallcli.cli.common import MAX_THREADS, number_option
+
 
 def scan(
     inputs: List[str] = typer.Argument(..., help="Video files, folders (searched recursively, see --glob), http(s)/rtsp "
@@ -17,8 +19,8 @@ def scan(
                                 show_default=False),
     task: str = typer.Option("count,activity,snr", "--task", help="Comma list of count, activity, snr: what each video is "
                              "asked. All come from one decode of the video."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Worker processes on this machine (one core "
-                                          "each). Default: the number of cores."),
+    workers: Optional[int] = number_option(None, "--workers", lo=1, hi=MAX_THREADS, integer=True, help="Worker "
+                                           "processes on this machine (one core each). Default: the number of cores."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run on an existing Dask cluster instead, e.g. "
                                             "tcp://10.0.0.5:8786 (its workers need this wallcli version installed)."),
     glob: Optional[List[str]] = typer.Option(None, "--glob", help="File names to take from folders, e.g. '*.mp4' "
@@ -27,7 +29,7 @@ def scan(
                                "resuming it."),
     windows: bool = typer.Option(False, "--windows", help="Keep every window's answer in count and activity "
                                  "(the lines grow by a few hundred bytes per 2 s of video)."),
-    timeout: float = typer.Option(300.0, "--timeout", min=0.0, help="Give a video up (an error line) when its decoder "
+    timeout: float = number_option(300.0, "--timeout", lo=0, hi=86400, help="Give a video up (an error line) when its decoder "
                                   "produces no frame for this many seconds. 0: wait forever."),
     json_out: bool = typer.Option(False, "--json", help="Print the run's summary as one JSON object on stdout."),
 ) -> None:

@@ -7,24 +7,24 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP
+from wallcli.cli.common import FORCE_HELP, MAX_THREADS, number_option
 
 ACTS = ("none", "walking", "crouching", "waving", "jumping")
 
 
-def _pair(text: str, name: str) -> tuple[float, float]:
+def _pair(text: str, name: str, most: float) -> tuple[float, float]:
     from wallcli.errors import UsageError
 
     try:
         a, b = (float(v) for v in text.split(","))
     except ValueError:
         raise UsageError(f"{name} must be two numbers MIN,MAX (got {text!r})") from None
-    if not (0 <= a <= b):
-        raise UsageError(f"{name} needs 0 <= MIN <= MAX (got {text!r})")
+    if not (0 <= a <= b <= most):  # NaN fails this too
+        raise UsageError(f"{name} needs 0 <= MIN <= MAX <= {most:g} (got {text!r})")
     return a, b
 
 
-def _size(text: str, name: str, sep: str = "x") -> tuple[int, int]:
+def _size(text: str, name: str, most: int, sep: str = "x") -> tuple[int, int]:
     from wallcli.errors import UsageError
 
     try:
@@ -33,23 +33,25 @@ def _size(text: str, name: str, sep: str = "x") -> tuple[int, int]:
         raise UsageError(f"{name} must look like 160{sep}120 (got {text!r})") from None
     if a < 2 or b < 2:
         raise UsageError(f"{name} is too small (got {text!r})")
+    if a > most or b > most:
+        raise UsageError(f"{name} is too large: at most {most}{sep}{most} (got {text!r})")
     return a, b
 
 
 def simulate(
     output: Path = typer.Option(..., "--output", "-o", help="Video to write (.mp4 = H.264, .mkv = lossless FFV1, .y4m = raw); "
                                 "the ground truth goes beside it as .json. With --dataset: the folder for the shards."),
-    people: Optional[int] = typer.Option(1, "--people", "-n", min=0, max=2, help="Number of people in the hidden room (0, 1 or 2)."),
+    people: Optional[int] = number_option(1, "--people", "-n", lo=0, hi=2, integer=True, help="Number of people in the hidden room (0, 1 or 2)."),
     activity: str = typer.Option("walking", "--activity", "-a", help="none | walking | crouching | waving | jumping | random; "
                                  "a comma list gives one per person (e.g. walking,waving). 'none' = standing still."),
-    seed: int = typer.Option(0, "--seed", help="Random seed: room, lamps, textures, people, paths, camera and noise all follow "
+    seed: int = number_option(0, "--seed", lo=0, hi=2**32 - 1, integer=True, help="Random seed: room, lamps, textures, people, paths, camera and noise all follow "
                              "from it. Same seed + options = identical video."),
-    duration: float = typer.Option(12.0, "--duration", min=0.2, max=600, help="Clip length in seconds."),
-    fps: float = typer.Option(30.0, "--fps", min=15, max=60, help="Frame rate (15-60)."),
+    duration: float = number_option(12.0, "--duration", lo=0.2, hi=600, help="Clip length in seconds."),
+    fps: float = number_option(30.0, "--fps", lo=15, hi=60, help="Frame rate."),
     size: str = typer.Option("320x240", "--size", help="Frame size WxH in pixels (even numbers for .mp4)."),
     grid: Optional[str] = typer.Option(None, "--grid", help="Wall points RxC where the irradiance is rendered and interpolated "
                                        "to pixels (default 64x64 for a video, 24x32 in dataset mode, for speed: the signal is smooth)."),
-    crf: int = typer.Option(18, "--crf", min=0, max=51, help="H.264 quality for .mp4 (0 = lossless, 18 = visually clean, 28 = "
+    crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality for .mp4 (0 = lossless, 18 = visually clean, 28 = "
                             "strong compression that erases faint signals)."),
     world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the seed's 2-D world "
                               "(people = 1-2 moving occluders, horizontal information only)."),
@@ -57,35 +59,36 @@ def simulate(
                                "clothing, body size, camera (an honest held-out validation set)."),
     distance: str = typer.Option("1,5", "--distance", help="MIN,MAX distance of people from the wall (m)."),
     speed: str = typer.Option("0.5,1.8", "--speed", help="MIN,MAX walking speed (m/s)."),
-    level: Optional[float] = typer.Option(None, "--level", min=5, max=250, help="Mean wall brightness in 8-bit codes (default: random from the seed)."),
-    iso_gain: Optional[float] = typer.Option(None, "--iso-gain", min=0, help="Codes per photo-electron: photon shot noise grows with it "
+    level: Optional[float] = number_option(None, "--level", lo=5, hi=250, help="Mean wall brightness in 8-bit codes (default: random from the seed)."),
+    iso_gain: Optional[float] = number_option(None, "--iso-gain", lo=0, hi=100, help="Codes per photo-electron: photon shot noise grows with it "
                                              "(0.01 bright scene/low ISO .. 2 dim room/high ISO; default random)."),
-    read_noise: Optional[float] = typer.Option(None, "--read-noise", min=0, help="Read noise, codes rms per sensor pixel (default random 0.3-3)."),
-    sensor_pixels: Optional[float] = typer.Option(None, "--sensor-pixels", min=1, help="Sensor pixels the wall covers in the "
+    read_noise: Optional[float] = number_option(None, "--read-noise", lo=0, hi=255, help="Read noise, codes rms per sensor pixel (default random 0.3-3)."),
+    sensor_pixels: Optional[float] = number_option(None, "--sensor-pixels", lo=1, hi=1e12, help="Sensor pixels the wall covers in the "
                                                   "imagined camera; the frame's noise is that of averaging them down "
                                                   "(default: the frame's own pixel count, i.e. no averaging)."),
-    prnu: Optional[float] = typer.Option(None, "--prnu", min=0, help="Pixel response non-uniformity, relative (default random 0.2-2 %)."),
-    gamma: Optional[float] = typer.Option(None, "--gamma", min=0, help="Tone curve exponent (2.2 ~ sRGB; 0 = linear; default random)."),
-    noise_scale: float = typer.Option(1.0, "--noise-scale", min=0, help="Multiply all temporal noise (0 leaves only the rounding dither)."),
-    drift: Optional[float] = typer.Option(None, "--drift", min=0, help="Slow light drift, relative amplitude (e.g. 0.005)."),
-    flicker: Optional[float] = typer.Option(None, "--flicker", min=0, help="Mains flicker, relative amplitude, aliased to the frame rate."),
-    mains: Optional[float] = typer.Option(None, "--mains", help="Mains frequency for flicker: 50 or 60 Hz."),
-    ae_steps: Optional[int] = typer.Option(None, "--ae-steps", min=0, max=10, help="Number of auto-exposure steps (each 0.5-3 %)."),
-    shake: Optional[float] = typer.Option(None, "--shake", min=0, help="Camera shake, rms pixels (sub-pixel, e.g. 0.1)."),
-    nuisances: float = typer.Option(0.0, "--nuisances", min=0, max=1, help="Probability that random drift/flicker/AE steps/shake "
+    prnu: Optional[float] = number_option(None, "--prnu", lo=0, hi=0.5, help="Pixel response non-uniformity, relative (default random 0.2-2 %)."),
+    gamma: Optional[float] = number_option(None, "--gamma", lo=0, hi=10, help="Tone curve exponent (2.2 ~ sRGB; 0 = linear; default random)."),
+    noise_scale: float = number_option(1.0, "--noise-scale", lo=0, hi=100, help="Multiply all temporal noise (0 leaves only the rounding dither)."),
+    drift: Optional[float] = number_option(None, "--drift", lo=0, hi=0.5, help="Slow light drift, relative amplitude (e.g. 0.005)."),
+    flicker: Optional[float] = number_option(None, "--flicker", lo=0, hi=0.5, help="Mains flicker, relative amplitude, aliased to the frame rate."),
+    mains: Optional[float] = number_option(None, "--mains", lo=50, hi=60, help="Mains frequency for flicker: 50 or 60 Hz."),
+    ae_steps: Optional[int] = number_option(None, "--ae-steps", lo=0, hi=10, integer=True, help="Number of auto-exposure steps (each 0.5-3 %)."),
+    shake: Optional[float] = number_option(None, "--shake", lo=0, hi=5, help="Camera shake, rms pixels (sub-pixel, e.g. 0.1)."),
+    nuisances: float = number_option(0.0, "--nuisances", lo=0, hi=1, help="Probability that random drift/flicker/AE steps/shake "
                                     "are switched on (explicit options above always apply)."),
     preview: Optional[Path] = typer.Option(None, "--preview", help="Also draw the room from above with the paths beside the "
                                            "video's space-time plots (PNG)."),
     json_out: bool = typer.Option(False, "--json", help="Print the ground truth (without per-frame positions) as JSON on stdout; "
                                   "with --dataset, a summary with the measured windows/s."),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP + " With --dataset: rebuild every shard."),
-    dataset: Optional[int] = typer.Option(None, "--dataset", min=1, help="Dataset mode: write N labelled 256-frame windows "
+    dataset: Optional[int] = number_option(None, "--dataset", lo=1, hi=10_000_000, integer=True, help="Dataset mode: write N labelled 256-frame windows "
                                           "(shards of .npz + dataset.json) to the -o folder instead of one video."),
     task: str = typer.Option("count", "--task", help="Dataset labels: count (0/1/2 people, every activity, mixed pairs) or "
                              "activity (none/walking/crouching/waving/jumping)."),
-    jobs: int = typer.Option(0, "--jobs", "-j", min=0, help="Dataset worker processes (0 = one per core)."),
-    windows_per_scene: int = typer.Option(4, "--windows-per-scene", min=1, max=16, help="Overlapping windows cut from each rendered clip."),
-    shard_scenes: int = typer.Option(32, "--shard-scenes", min=1, help="Scenes per shard file."),
+    jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
+                              help="Dataset worker processes (0 = one per core; at most 4 per core)."),
+    windows_per_scene: int = number_option(4, "--windows-per-scene", lo=1, hi=16, integer=True, help="Overlapping windows cut from each rendered clip."),
+    shard_scenes: int = number_option(32, "--shard-scenes", lo=1, hi=100_000, integer=True, help="Scenes per shard file."),
     placement: str = typer.Option("visible", "--placement", help="Dataset mode: where people go. visible: 0.8-4 m from the "
                                   "wall, walkers within 1.5 m of the observed patch (their signal stands above the noise); "
                                   "anywhere: 1-5 m, roaming 2.5 m, like single videos."),
@@ -111,14 +114,15 @@ def simulate(
         raise UsageError(f"--world must be room, flatland or mixed (got {world!r})")
     if domain not in ("base", "shifted", "wide"):
         raise UsageError(f"--domain must be base, shifted or wide (got {domain!r})")
-    grid_rc = _size(grid, "--grid") if grid else ((24, 32) if dataset is not None else (64, 64))
+    grid_rc = _size(grid, "--grid", 512) if grid else ((24, 32) if dataset is not None else (64, 64))
+    # checked in both modes, so that a mistyped value is never silently ignored
+    if task not in ("count", "activity"):
+        raise UsageError(f"--task must be count or activity (got {task!r})")
+    if placement not in ("visible", "anywhere", "wide"):
+        raise UsageError(f"--placement must be visible, anywhere or wide (got {placement!r})")
     if dataset is not None:
-        if task not in ("count", "activity"):
-            raise UsageError(f"--task must be count or activity (got {task!r})")
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
-        if placement not in ("visible", "anywhere", "wide"):
-            raise UsageError(f"--placement must be visible, anywhere or wide (got {placement!r})")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
                         json_out, placement)
     if world == "mixed":
@@ -130,12 +134,12 @@ def simulate(
     suffix = output.suffix.lower()
     if suffix not in (".mp4", ".mkv", ".y4m", ".mov"):
         raise UsageError(f"-o must end in .mp4, .mkv or .y4m (got {output})")
-    w, h = _size(size, "--size")
+    w, h = _size(size, "--size", 8192)
     if suffix in (".mp4", ".mov") and (w % 2 or h % 2):
         raise UsageError(f"H.264 needs an even frame size (got {w}x{h})")
     if w < 16 or h < 16:
         raise UsageError("--size must be at least 16x16")
-    dist, spd = _pair(distance, "--distance"), _pair(speed, "--speed")
+    dist, spd = _pair(distance, "--distance", 50), _pair(speed, "--speed", 10)
     if dist[0] < 0.3:
         raise UsageError("--distance MIN must be at least 0.3 m (bodies must stay in front of the wall)")
     if mains is not None and mains not in (50.0, 60.0):
@@ -148,8 +152,8 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
            preview, json_out, force, acts, suffix, **_):
     import json
 
-    from wallcli.cli.output import emit_json, progress
-    from wallcli.io.writer import VideoWriter, atomic_paths, check_outputs
+    from wallcli.cli.output import progress
+    from wallcli.io.writer import VideoWriter, atomic_paths, check_outputs, committed_together
     from wallcli.sim.camera import video_pix_fmt
 
     sidecar = output.with_suffix(".json")
@@ -176,7 +180,8 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
     pix_fmt = video_pix_fmt(scene.camera) if suffix != ".y4m" else None
     # video and ground truth appear together or not at all (the sidecar is renamed first, so a
     # video that is there always has its truth beside it)
-    with atomic_paths([sidecar, output], force=force) as (tmp_truth, tmp_video):
+    # (and the preview and the JSON with them: committed_together)
+    with committed_together(), atomic_paths([sidecar, output], force=force) as (tmp_truth, tmp_video):
         with VideoWriter(tmp_video, fps, w, h, codec=None if codec == "rawvideo" else codec, crf=crf,
                          pix_fmt=pix_fmt, repeatable=True) as vw:
             with progress("simulate", n) as advance:
@@ -186,12 +191,18 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         truth = scene.truth()
         truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
         tmp_truth.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
+        _finish(output, tmp_video, sidecar, truth, preview, json_out, force)
+
+
+def _finish(output, tmp_video, sidecar, truth, preview, json_out, force) -> None:
+    from wallcli.cli.output import emit_json
+
     if preview is not None:
         from wallcli.io.video import open_video
         from wallcli.plots.scene import save_preview
         from wallcli.signal.stplot import compute_stplot
 
-        with open_video(output) as reader:
+        with open_video(tmp_video) as reader:  # the video is placed with the preview, not before
             plot = compute_stplot(reader)
         save_preview(preview, truth, plot, force=force)
     if json_out:

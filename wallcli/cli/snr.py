@@ -8,25 +8,36 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, THREADS_HELP
+from wallcli.cli.common import FORCE_HELP, THREADS_HELP, Number, number_option, threads_option
 
-# Parameters of --predict, by the name --sweep uses: (option, default, help).
+# Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
+# checks the option and every value of a --sweep alike.
 PREDICT_PARAMS = {
-    "distance": ("--distance", 2.0, "Person-to-wall distance d (m)."),
-    "radius": ("--radius", 0.25, "Person radius r (m); the person is a disk of area A = pi r^2 facing the wall."),
-    "area": ("--area", None, "Person area A (m^2), instead of --radius."),
-    "albedo": ("--albedo", 0.7, "Wall albedo alpha (0-1)."),
-    "person_radiance": ("--person-radiance", 20.0, "Person radiance L_p, in code values (what a white wall lit by it alone would record)."),
-    "background_radiance": ("--background-radiance", 200.0, "Surroundings' radiance L_s, same units."),
-    "contrast": ("--contrast", None, "L_p - L_s directly, instead of the two radiances."),
-    "occupancy": ("--occupancy", 1.0, "Fraction q of the time the person is there."),
-    "mean_code": ("--mean-code", None, "Camera model: the wall's mean code value (8-bit scale). With --gain, also predicts noise and SNR."),
-    "gain": ("--gain", None, "Camera model: electrons per 8-bit code value."),
-    "read_noise": ("--read-noise", 2.0, "Camera model: read noise (electrons RMS)."),
-    "bits": ("--bits", 8, "Camera model: bit depth (quantisation step 2^(8-bits) on the 8-bit scale)."),
-    "pixels": ("--pixels", 1.0, "Camera model: pixels averaged."),
-    "frames": ("--frames", 1.0, "Camera model: frames averaged."),
+    "distance": ("--distance", 2.0, "Person-to-wall distance d (m).", dict(lo=0.01, hi=1000)),
+    "radius": ("--radius", 0.25, "Person radius r (m); the person is a disk of area A = pi r^2 facing the wall.",
+               dict(lo=0, hi=100, lo_open=True)),
+    "area": ("--area", None, "Person area A (m^2), instead of --radius.", dict(lo=0, hi=1e4, lo_open=True)),
+    "albedo": ("--albedo", 0.7, "Wall albedo alpha.", dict(lo=0, hi=1)),
+    "person_radiance": ("--person-radiance", 20.0, "Person radiance L_p, in code values (what a white wall lit by it "
+                        "alone would record).", dict(lo=0, hi=1e6)),
+    "background_radiance": ("--background-radiance", 200.0, "Surroundings' radiance L_s, same units.", dict(lo=0, hi=1e6)),
+    "contrast": ("--contrast", None, "L_p - L_s directly, instead of the two radiances.", dict(lo=-1e6, hi=1e6)),
+    "occupancy": ("--occupancy", 1.0, "Fraction q of the time the person is there.", dict(lo=0, hi=1)),
+    "mean_code": ("--mean-code", None, "Camera model: the wall's mean code value (8-bit scale). With --gain, also "
+                  "predicts noise and SNR.", dict(lo=0, hi=255)),
+    "gain": ("--gain", None, "Camera model: electrons per 8-bit code value.", dict(lo=0, hi=1e6, lo_open=True)),
+    "read_noise": ("--read-noise", 2.0, "Camera model: read noise (electrons RMS).", dict(lo=0, hi=1e6)),
+    "bits": ("--bits", 8, "Camera model: bit depth (quantisation step 2^(8-bits) on the 8-bit scale).",
+             dict(lo=1, hi=16, integer=True)),
+    "pixels": ("--pixels", 1.0, "Camera model: pixels averaged.", dict(lo=1, hi=1e15)),
+    "frames": ("--frames", 1.0, "Camera model: frames averaged.", dict(lo=1, hi=1e9)),
 }
+MAX_SWEEP = 10000
+
+
+def _predict_option(name: str):
+    flag, default, text, rng = PREDICT_PARAMS[name]
+    return number_option(default, flag, help=text, **rng)
 
 
 def snr(
@@ -40,29 +51,29 @@ def snr(
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
                                         "with --predict --sweep, SNR (or signal power) against the swept parameter."),
-    max_pixels: int = typer.Option(32768, "--max-pixels", min=0, help="Pixels measured per frame: a larger ROI is sampled by a regular "
+    max_pixels: int = number_option(32768, "--max-pixels", lo=0, hi=2**31, integer=True, help="Pixels measured per frame: a larger ROI is sampled by a regular "
                                    "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
                                    "decode speed). 0 = every pixel of the ROI (exact, slower)."),
     predict_mode: bool = typer.Option(False, "--predict", help="Predict from the scene's physics (seed §3.1) instead of measuring a video."),
     approx: bool = typer.Option(False, "--approx", help="--predict: far-field coverage A/(pi d^2) instead of the exact r^2/(r^2+d^2)."),
     sweep: Optional[str] = typer.Option(None, "--sweep", help="--predict: NAME=start:stop:step over any parameter, e.g. distance=1:4:0.25 "
                                         "(names: " + ", ".join(k.replace("_", "-") for k in PREDICT_PARAMS) + ")."),
-    distance: float = typer.Option(2.0, "--distance", help=PREDICT_PARAMS["distance"][2]),
-    radius: float = typer.Option(0.25, "--radius", help=PREDICT_PARAMS["radius"][2]),
-    area: Optional[float] = typer.Option(None, "--area", help=PREDICT_PARAMS["area"][2]),
-    albedo: float = typer.Option(0.7, "--albedo", help=PREDICT_PARAMS["albedo"][2]),
-    person_radiance: float = typer.Option(20.0, "--person-radiance", help=PREDICT_PARAMS["person_radiance"][2]),
-    background_radiance: float = typer.Option(200.0, "--background-radiance", help=PREDICT_PARAMS["background_radiance"][2]),
-    contrast: Optional[float] = typer.Option(None, "--contrast", help=PREDICT_PARAMS["contrast"][2]),
-    occupancy: float = typer.Option(1.0, "--occupancy", help=PREDICT_PARAMS["occupancy"][2]),
-    mean_code: Optional[float] = typer.Option(None, "--mean-code", help=PREDICT_PARAMS["mean_code"][2]),
-    gain: Optional[float] = typer.Option(None, "--gain", help=PREDICT_PARAMS["gain"][2]),
-    read_noise: float = typer.Option(2.0, "--read-noise", help=PREDICT_PARAMS["read_noise"][2]),
-    bits: int = typer.Option(8, "--bits", min=1, max=16, help=PREDICT_PARAMS["bits"][2]),
-    pixels: float = typer.Option(1.0, "--pixels", min=1.0, help=PREDICT_PARAMS["pixels"][2]),
-    frames: float = typer.Option(1.0, "--frames", min=1.0, help=PREDICT_PARAMS["frames"][2]),
+    distance: float = _predict_option("distance"),
+    radius: float = _predict_option("radius"),
+    area: Optional[float] = _predict_option("area"),
+    albedo: float = _predict_option("albedo"),
+    person_radiance: float = _predict_option("person_radiance"),
+    background_radiance: float = _predict_option("background_radiance"),
+    contrast: Optional[float] = _predict_option("contrast"),
+    occupancy: float = _predict_option("occupancy"),
+    mean_code: Optional[float] = _predict_option("mean_code"),
+    gain: Optional[float] = _predict_option("gain"),
+    read_noise: float = _predict_option("read_noise"),
+    bits: int = _predict_option("bits"),
+    pixels: float = _predict_option("pixels"),
+    frames: float = _predict_option("frames"),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+    threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Measure the wall signal and the noise in a video (seed §4), per colour channel.
 
@@ -80,18 +91,23 @@ def snr(
       wallcli snr --predict --sweep distance=1:4:0.25 --plot fade.png
     """
     from wallcli.errors import UsageError
+    from wallcli.io.writer import committed_together
 
     if heatmap_of not in ("signal", "snr"):
         raise UsageError(f"--heatmap-of must be signal or snr (got {heatmap_of!r})")
     if predict_mode:
+        if roi is not None or heatmap is not None:
+            raise UsageError("--roi and --heatmap measure a video; --predict reads none")
         params = {k: v for k, v in locals().items() if k in PREDICT_PARAMS}
-        return _predict(params, approx=approx, sweep=sweep, plot=plot, json_out=json_out, force=force)
+        with committed_together():  # the figure and the data on stdout: all or none
+            return _predict(params, approx=approx, sweep=sweep, plot=plot, json_out=json_out, force=force)
     if input is None:
         raise UsageError("give a video (INPUT), or --predict for the physics alone")
     if sweep is not None:
         raise UsageError("--sweep goes with --predict")
-    _measure(input, roi=roi, json_out=json_out, heatmap=heatmap, heatmap_of=heatmap_of, plot=plot,
-             max_pixels=max_pixels, force=force, threads=threads)
+    with committed_together():
+        _measure(input, roi=roi, json_out=json_out, heatmap=heatmap, heatmap_of=heatmap_of, plot=plot,
+                 max_pixels=max_pixels, force=force, threads=threads)
 
 
 # ------------------------------------------------------------------------------------- measure
@@ -174,6 +190,8 @@ def _triple(v, fmt: str = "{:.4g}") -> str:
 
 # ------------------------------------------------------------------------------------- predict
 def _parse_sweep(text: str) -> tuple[str, list[float]]:
+    import math
+
     import numpy as np
 
     from wallcli.errors import UsageError
@@ -187,12 +205,18 @@ def _parse_sweep(text: str) -> tuple[str, list[float]]:
         start, stop, step = (float(p) for p in rng.split(":"))
     except ValueError:
         raise UsageError(f"--sweep must be NAME=start:stop:step (got {text!r})") from None
+    if not all(math.isfinite(x) for x in (start, stop, step)):
+        raise UsageError(f"--sweep needs finite numbers (got {text!r})")
     if step <= 0 or stop < start:
         raise UsageError("--sweep needs step > 0 and stop >= start")
-    values = np.arange(start, stop + step * 1e-9, step)
-    if len(values) > 10000:
-        raise UsageError("--sweep: more than 10000 values; use a larger step")
-    return key, [float(v) for v in values]
+    span = (stop - start) / step  # counted before np.arange, which would allocate them all
+    if not span < MAX_SWEEP:
+        raise UsageError(f"--sweep: more than {MAX_SWEEP} values; use a larger step")
+    count = math.floor(span + 1e-9) + 1
+    flag, _, _, limits = PREDICT_PARAMS[key]
+    check = Number(f"--sweep {flag[2:]}", **limits)  # each swept value obeys the option's own range
+    values = [check(float(v)) for v in np.arange(start, stop + step * 1e-9, step)[:count]]
+    return key, values
 
 
 def _one(p: dict, approx: bool) -> dict:

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, parse_roi
+from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
@@ -15,15 +15,17 @@ def stplot(
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="Write the plots to this .npz (float32 arrays + JSON metadata)."),
     png: Optional[Path] = typer.Option(None, "--png", help="Draw both plots, amplified, to this PNG."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
-    bins: int = typer.Option(64, "--bins", min=2, max=4096, help="Positions per plot (the networks use 64)."),
+    bins: int = number_option(64, "--bins", lo=2, hi=4096, integer=True, help="Positions per plot (the networks use 64)."),
     mean: str = typer.Option("clip", "--mean", help="Temporal mean removal: 'clip' (whole recording; files), "
                              "'window' (trailing moving average) or 'ema' (exponential running mean); the last two are causal, for streams."),
-    mean_seconds: float = typer.Option(10.0, "--mean-seconds", min=0.01, help="Time span of the 'window' / time constant of the 'ema' mean."),
+    mean_seconds: float = number_option(10.0, "--mean-seconds", lo=0.01, hi=3600, help="Time span of the 'window' / time constant of the 'ema' mean."),
     style: str = typer.Option("rgb", "--style", help="PNG style: 'rgb' (colour around neutral grey) or 'diverging' (luminance, blue-white-red)."),
-    gain: Optional[float] = typer.Option(None, "--gain", help="PNG amplification (default: automatic, robust spread to +-3 sigma)."),
+    gain: Optional[float] = number_option(None, "--gain", lo=0, hi=1e6, lo_open=True, help="PNG amplification: display "
+                                          "range per code value, full scale = +-0.5/gain code values (default: automatic, "
+                                          "+-3 robust sigma of the signal fill the range)."),
     json_out: bool = typer.Option(False, "--json", help="Print a metadata summary as JSON on stdout."),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    threads: int = typer.Option(0, "--threads", min=0, help=THREADS_HELP),
+    threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
     64 positions x time x RGB) and over columns (vertical plot).
@@ -50,16 +52,24 @@ def stplot(
         raise UsageError(f"-o must end in .npz (got {output})")
     roi_t = parse_roi(roi)
 
-    from wallcli.cli.output import emit_json, progress
-    from wallcli.io.arrays import save_npz
+    from wallcli.cli.output import progress
     from wallcli.io.video import open_video
-    from wallcli.io.writer import check_outputs
-    from wallcli.signal.stplot import compute_stplot, to_arrays
+    from wallcli.io.writer import check_outputs, committed_together
+    from wallcli.signal.stplot import compute_stplot
 
     check_outputs([output, png], force=force, inputs=[input])
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
             plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)
+    with committed_together():  # the .npz, the PNG and the JSON: all or none
+        _write(plot, input, output, png, style, gain, json_out, force)
+
+
+def _write(plot, input, output, png, style, gain, json_out, force) -> None:
+    from wallcli.cli.output import emit_json
+    from wallcli.io.arrays import save_npz
+    from wallcli.signal.stplot import to_arrays
+
     if output is not None:
         save_npz(output, *to_arrays(plot), force=force)
     if png is not None:

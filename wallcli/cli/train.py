@@ -7,6 +7,8 @@ from typing import List, Optional
 
 import typer
 
+from wallcli.cli.common import number_option, threads_option
+
 INSTALL_HINT = "pip install torch==2.13.0 && pip install 'wallcli[train]'"
 
 
@@ -21,26 +23,26 @@ def train(
                                     "repeat it to train on several folders as one dataset."),
     out: Path = typer.Option(..., "--out", "-o", help="Model to write (.onnx); its card goes beside it (.json)."),
     val: Optional[Path] = typer.Option(None, "--val", help="Validation dataset folder (default: hold out --val-fraction of --data)."),
-    val_fraction: float = typer.Option(0.1, "--val-fraction", min=0.0, max=0.5, help="Share of --data held out when there is no --val."),
-    epochs: int = typer.Option(20, "--epochs", min=1, help="Total epochs (a resumed run continues up to this)."),
-    batch_size: int = typer.Option(32, "--batch-size", min=2, help="Windows per optimisation step."),
-    threads: int = typer.Option(0, "--threads", min=0, help="Torch CPU threads (0: torch's default)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of initialisation, split, batch order and augmentation."),
+    val_fraction: float = number_option(0.1, "--val-fraction", lo=0, hi=0.5, help="Share of --data held out when there is no --val."),
+    epochs: int = number_option(20, "--epochs", lo=1, hi=100_000, integer=True, help="Total epochs (a resumed run continues up to this)."),
+    batch_size: int = number_option(32, "--batch-size", lo=2, hi=65536, integer=True, help="Windows per optimisation step."),
+    threads: int = threads_option("Torch CPU threads (0: torch's default)."),
+    seed: int = number_option(0, "--seed", lo=0, hi=2**32 - 1, integer=True, help="Seed of initialisation, split, batch order and augmentation."),
     checkpoint: Optional[Path] = typer.Option(None, "--checkpoint", help="Checkpoint file (default: OUT with suffix .ckpt.pt)."),
-    checkpoint_minutes: float = typer.Option(5.0, "--checkpoint-minutes", min=0.1, help="Minutes between checkpoints within an epoch."),
+    checkpoint_minutes: float = number_option(5.0, "--checkpoint-minutes", lo=0.1, hi=1e6, help="Minutes between checkpoints within an epoch."),
     resume: bool = typer.Option(True, "--resume/--no-resume", help="Continue from the checkpoint when it exists."),
     augment: bool = typer.Option(True, "--augment/--no-augment", help="Label-preserving augmentation (see wallcli/train/augment.py)."),
     name: Optional[str] = typer.Option(None, "--name", help="Model name in the card (default: wallcli-TASK)."),
     model_version: str = typer.Option("1.0.0", "--model-version", help="Model version in the card."),
-    stride: int = typer.Option(64, "--stride", min=1, help="Default inference stride recorded in the card (frames)."),
-    min_snr_db: Optional[float] = typer.Option(None, "--min-snr-db", help="Skip training windows whose movers' "
+    stride: int = number_option(64, "--stride", lo=1, hi=65536, integer=True, help="Default inference stride recorded in the card (frames)."),
+    min_snr_db: Optional[float] = number_option(None, "--min-snr-db", lo=-200, hi=200, help="Skip training windows whose movers' "
                                                "noise-free signal is this many dB below the plot noise or more (per-window "
                                                "snr_db from the simulator); windows with nobody moving always stay. "
                                                "Validation keeps every window."),
-    anneal: int = typer.Option(0, "--anneal", min=0, help="Lower the learning rate over the last N epochs (cosine, "
+    anneal: int = number_option(0, "--anneal", lo=0, hi=100_000, integer=True, help="Lower the learning rate over the last N epochs (cosine, "
                                "down to 1/100 of --lr); 0: a constant --lr throughout. Raising --epochs with "
                                "--anneal on a finished run continues it from its checkpoint."),
-    ema: float = typer.Option(0.995, "--ema", min=0.0, max=0.9999, help="Per-step decay of the moving average of the "
+    ema: float = number_option(0.995, "--ema", lo=0, hi=0.9999, help="Per-step decay of the moving average of the "
                               "weights that is validated and exported (0: the raw weights)."),
     select: str = typer.Option("last", "--select", help="Export the weights after the last epoch ('last': the card's "
                                "validation accuracy is then a plain measurement) or of the epoch with the best "
@@ -48,7 +50,7 @@ def train(
     quantize: str = typer.Option("none", "--quantize", help="none: ship the float32 graph; int8: ship a statically "
                                  "quantised graph (about 1.6x faster on CPU; calibrated on 256 training windows, its "
                                  "validation accuracy measured again and written in the card)."),
-    superpose: float = typer.Option(0.0, "--superpose", min=0.0, max=1.0, help="count only: share of training windows "
+    superpose: float = number_option(0.0, "--superpose", lo=0, hi=1, help="count only: share of training windows "
                                     "replaced by their sum with another window of the batch, labels added (light "
                                     "transport is linear; see wallcli/train/augment.py). 0: off."),
     preprocessing: str = typer.Option("v1", "--preprocessing", help="Window normalisation the net learns on, recorded "
@@ -64,11 +66,11 @@ def train(
                                          "on: fit the card's decided/undetermined thresholds there (per answer and band of "
                                          "measured signal; wallcli/infer/confidence.py). Without it, every answer of the "
                                          "model is 'undetermined'."),
-    confidence_level: float = typer.Option(0.97, "--confidence-level", min=0.5, max=0.999, help="With --calibrate: "
+    confidence_level: float = number_option(0.97, "--confidence-level", lo=0.5, hi=0.999, help="With --calibrate: "
                                            "how often a decided answer must have been right in calibration."),
     init: Optional[Path] = typer.Option(None, "--init", help="Start from the weights of an exported model of the same "
                                         "task (its .onnx, float or int8): fine-tuning. The card records which."),
-    lr: float = typer.Option(1e-3, "--lr", min=1e-7, max=1.0, help="RMSProp learning rate (the seed's 1e-3; "
+    lr: float = number_option(1e-3, "--lr", lo=1e-7, hi=1, help="RMSProp learning rate (the seed's 1e-3; "
                              "--anneal ends at 1/100 of it). Lower it to fine-tune from --init."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -55,6 +56,13 @@ def input_spec(name: str, bins: int, window: int) -> dict[str, Any]:
             "shape": [None, 3, bins, window], "dtype": "float32"}
 
 
+# A card is a few tens of kB; anything far larger is not a card (and would be read whole).
+MAX_CARD_BYTES = 16 * 1024 * 1024
+# Ranges of the numbers inference takes from a card: fps sets the resampling (1e9 fps once
+# asked for terabytes), window and bins the shape of every array.
+LIMITS = {"fps": (1, 1000), "window": (2, 65536), "bins": (2, 4096), "stride": (1, 65536)}
+
+
 def read_card(model_path: Path) -> dict[str, Any]:
     """Read and validate the card beside ``model_path``; WallcliError when absent or wrong."""
     path = card_path(model_path)
@@ -62,14 +70,33 @@ def read_card(model_path: Path) -> dict[str, Any]:
         raise WallcliError(f"model card not found: {path}",
                            hint="a model needs its card beside it: same name, suffix .json")
     try:
-        card = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        if path.stat().st_size > MAX_CARD_BYTES:
+            raise WallcliError(f"model card {path} is {path.stat().st_size} bytes; a card is a small JSON file")
+        card = json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_constant)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, ValueError) as e:
         raise WallcliError(f"model card {path} is not valid JSON: {e}") from None
+    except RecursionError:
+        raise WallcliError(f"model card {path} is not valid JSON: nested too deeply") from None
     validate_card(card, path)
     return card
 
 
+def _no_constant(name: str):
+    # Python's json reads NaN and Infinity, which JSON does not have
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def _is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _is_int(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
 def validate_card(card: Any, where: Path | str = "model card") -> None:
+    """Every field inference reads, by type and range, each failure naming its field. Fields it
+    does not read (training history, notes, blocks added by newer model owners) are left alone."""
     def bad(msg: str) -> WallcliError:
         return WallcliError(f"{where}: {msg}")
 
@@ -80,33 +107,82 @@ def validate_card(card: Any, where: Path | str = "model card") -> None:
     missing = [k for k in REQUIRED if k not in card]
     if missing:
         raise bad(f"missing field(s): {', '.join(missing)}")
+    for key in ("name", "version"):
+        if not isinstance(card[key], str) or not card[key].strip() or len(card[key]) > 200:
+            raise bad(f"field {key!r} must be a non-empty string of at most 200 characters (got {card[key]!r:.60})")
     task = card["task"]
-    if task not in TASK_INPUTS:
-        raise bad(f"unknown task {task!r}")
-    if card["preprocessing"] not in NORMALIZATION_TEXT:
-        raise bad(f"unsupported preprocessing {card['preprocessing']!r} (this wallcli applies "
+    if not isinstance(task, str) or task not in TASK_INPUTS:
+        raise bad(f"field 'task' must be one of {', '.join(TASK_INPUTS)} (got {task!r:.60})")
+    if not isinstance(card["preprocessing"], str) or card["preprocessing"] not in NORMALIZATION_TEXT:
+        raise bad(f"unsupported preprocessing {card['preprocessing']!r:.80} (this wallcli applies "
                   f"{' or '.join(repr(k) for k in NORMALIZATION_TEXT)})")
-    if not isinstance(card["classes"], list) or len(card["classes"]) < 2:
-        raise bad("classes must be a list of at least 2 labels")
-    names = [i.get("name") for i in card["inputs"] if isinstance(i, dict)]
+    fps = card["fps"]
+    lo, hi = LIMITS["fps"]
+    if not _is_number(fps) or not lo <= fps <= hi:
+        raise bad(f"field 'fps' must be a number from {lo} to {hi} (got {fps!r:.60})")
+    for key in ("window", "bins", "stride"):
+        lo, hi = LIMITS[key]
+        if not _is_int(card[key]) or not lo <= card[key] <= hi:
+            raise bad(f"field {key!r} must be an integer from {lo} to {hi} (got {card[key]!r:.60})")
+    classes = card["classes"]
+    if (not isinstance(classes, list) or not 2 <= len(classes) <= 1000
+            or not all((isinstance(c, str) and c) or _is_int(c) for c in classes)):
+        raise bad("field 'classes' must be a list of 2 to 1000 labels (integers or non-empty strings)")
+    if len({repr(c) for c in classes}) != len(classes):
+        raise bad(f"field 'classes' lists a label twice: {classes}")
+    inputs = card["inputs"]
+    if not isinstance(inputs, list) or not all(isinstance(i, dict) for i in inputs):
+        raise bad("field 'inputs' must be a list of objects")
+    names = [i.get("name") for i in inputs]
     if names not in [list(a) for a in ALLOWED_INPUTS[task]]:
         raise bad(f"a {task} model takes inputs {' or '.join(map(str, ALLOWED_INPUTS[task]))}, card lists {names}")
-    for spec in card["inputs"]:
+    for spec in inputs:
         if spec.get("layout") != INPUT_LAYOUT:
             raise bad(f"input {spec['name']!r} layout must be {INPUT_LAYOUT}")
-        if list(spec.get("shape", []))[1:] != [3, card["bins"], card["window"]]:
-            raise bad(f"input {spec['name']!r} shape {spec.get('shape')} does not match bins/window")
-    for key in ("window", "bins", "stride"):
-        if not isinstance(card[key], int) or card[key] < 1:
-            raise bad(f"{key} must be a positive integer")
-    if not isinstance(card["sha256"], str) or len(card["sha256"]) != 64:
-        raise bad("sha256 must be 64 hex digits")
+        shape = spec.get("shape")
+        if (not isinstance(shape, list) or len(shape) != 4 or not (shape[0] is None or _is_int(shape[0]))
+                or shape[1:] != [3, card["bins"], card["window"]]):
+            raise bad(f"input {spec['name']!r} shape {shape!r:.80} does not match bins/window "
+                      f"([null, 3, {card['bins']}, {card['window']}])")
+        if spec.get("dtype", "float32") != "float32":
+            raise bad(f"input {spec['name']!r} dtype must be float32 (got {spec.get('dtype')!r:.40})")
+    output = card["output"]
+    if not isinstance(output, dict) or output.get("name", OUTPUT_NAME) != OUTPUT_NAME:
+        raise bad(f"field 'output' must be an object naming the output {OUTPUT_NAME!r}")
+    sha = card["sha256"]
+    if not isinstance(sha, str) or len(sha) != 64 or any(c not in "0123456789abcdefABCDEF" for c in sha):
+        raise bad("field 'sha256' must be 64 hex digits")
+    _validate_accuracy(card.get("validation"), "validation", bad)
     if card.get("confidence") is not None:
         from wallcli.infer.confidence import validate_block
 
         msg = validate_block(card["confidence"], len(card["classes"]))
         if msg:
             raise bad(msg)
+
+
+def _validate_accuracy(block: Any, name: str, bad) -> None:
+    """The validation figures the commands print under their tables (see cli._classify)."""
+    if block is None:
+        return
+    if not isinstance(block, dict):
+        raise bad(f"field {name!r} must be an object")
+    if "accuracy" in block and not (_is_number(block["accuracy"]) and 0 <= block["accuracy"] <= 1):
+        raise bad(f"field '{name}.accuracy' must be a number from 0 to 1 (got {block['accuracy']!r:.40})")
+    ci = block.get("accuracy_95ci")
+    if ci is not None and not (isinstance(ci, list) and len(ci) == 2
+                               and all(_is_number(x) and 0 <= x <= 1 for x in ci)):
+        raise bad(f"field '{name}.accuracy_95ci' must be two numbers from 0 to 1 (got {ci!r:.60})")
+    if "min_snr_db" in block and not _is_number(block["min_snr_db"]):
+        raise bad(f"field '{name}.min_snr_db' must be a number (got {block['min_snr_db']!r:.40})")
+    if "visible" in block:
+        _validate_accuracy(block["visible"], f"{name}.visible", bad)
+    others = block.get("other_sets")
+    if others is not None:
+        if not isinstance(others, list):
+            raise bad(f"field '{name}.other_sets' must be a list")
+        for i, other in enumerate(others):
+            _validate_accuracy(other, f"{name}.other_sets[{i}]", bad)
 
 
 def write_card(path: Path, card: dict[str, Any]) -> None:

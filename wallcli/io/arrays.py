@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import os
 import zipfile
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +27,10 @@ def save_npz(path: str | os.PathLike, arrays: dict[str, np.ndarray], meta: dict,
             np.savez(fh, **payload)
 
 
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not a JSON number")
+
+
 def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[str, np.ndarray], dict]:
     """Load a wallcli ``.npz``; ``kind`` checks ``meta['format']``. Corrupt files raise WallcliError."""
     p = Path(path)
@@ -40,15 +43,25 @@ def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[
     try:
         with np.load(p, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, zlib.error) as exc:
-        raise WallcliError(f"{p} is not a readable .npz file ({type(exc).__name__}: {exc})") from exc
+    except MemoryError:  # a header that declares an array far larger than the file
+        raise WallcliError(f"{p} is not a readable .npz file (it declares an array too large for memory)") from None
+    except Exception as exc:  # noqa: BLE001
+        # zipfile, zlib and NumPy's .npy header parser (Python's tokenizer and literal_eval) raise
+        # a dozen kinds of error on damaged bytes (BadZipFile, zlib.error, struct.error,
+        # tokenize.TokenError, SyntaxError, NotImplementedError, ...): all mean a damaged file
+        raise WallcliError(f"{p} is not a readable .npz file ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+    odd = [k for k, v in arrays.items() if not isinstance(v, np.ndarray)]
+    if odd:  # np.load hands back members that are not .npy as raw bytes
+        raise WallcliError(f"{p} is not a readable .npz file (member {odd[0]!r} is not a NumPy array)")
     meta_arr = arrays.pop(META_KEY, None)
     if meta_arr is None:
         raise WallcliError(f"{p} has no wallcli metadata; was it written by wallcli?")
+    if meta_arr.shape != () or meta_arr.dtype.kind != "U":
+        raise WallcliError(f"{p} has corrupt metadata (not a JSON string)")
     try:
-        meta = json.loads(str(meta_arr[()]))
-    except (json.JSONDecodeError, TypeError, IndexError) as exc:
-        raise WallcliError(f"{p} has corrupt metadata: {exc}") from exc
+        meta = json.loads(str(meta_arr[()]), parse_constant=_no_constant)
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError
+        raise WallcliError(f"{p} has corrupt metadata: {exc}") from None
     if not isinstance(meta, dict):
         raise WallcliError(f"{p} has corrupt metadata (not a JSON object)")
     if kind is not None and meta.get("format") != kind:

@@ -212,6 +212,9 @@ class VideoReader:
             self._container.close()
             raise WallcliError(f"{source} has no video stream")
         stream = self._container.streams.video[0]
+        if stream.codec_context is None:  # a codec FFmpeg has no decoder for (or a damaged header naming one)
+            self._container.close()
+            raise WallcliError(f"{source}: FFmpeg cannot decode its video codec")
         stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
         stream.codec_context.thread_count = int(threads)
         self._stream = stream

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import tempfile
 from contextlib import contextmanager
+from contextvars import ContextVar
 from fractions import Fraction
 from pathlib import Path
 from typing import Iterable, Iterator
@@ -71,17 +72,21 @@ def atomic_path(path: str | os.PathLike, *, force: bool = False) -> Iterator[Pat
         yield tmp
 
 
+# The outputs of the running committed_together() block, awaiting their rename: (temporaries, outputs, force).
+_GROUP: ContextVar[list | None] = ContextVar("wallcli_commit_group", default=None)
+
+
 @contextmanager
 def atomic_paths(paths: Iterable, *, force: bool = False) -> Iterator[list[Path]]:
     """:func:`atomic_path` for outputs that only make sense together (a video and its ground truth).
 
     Every temporary is written first; then they are renamed in the order given, so list last
     the file readers look for (the video: once it is there, its sidecar is too). If anything
-    fails, renames included, none of the outputs is left.
+    fails, renames included, none of the outputs is left. Inside :func:`committed_together`,
+    the renames wait for the end of that block.
     """
     outs = [Path(p) for p in paths]
     tmps: list[Path] = []
-    placed: list[Path] = []
     try:
         for out in outs:
             check_output(out, force=force)
@@ -91,20 +96,67 @@ def atomic_paths(paths: Iterable, *, force: bool = False) -> Iterator[list[Path]
             os.chmod(tmp_name, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
         yield list(tmps)
         raise_if_interrupted()  # a `kill` whose exception Python swallowed still places nothing
+    except BaseException:
+        _discard(tmps)
+        raise
+    group = _GROUP.get()
+    if group is not None:
+        group.append((tmps, outs, force))
+    else:
+        _commit([(tmps, outs, force)])
+
+
+@contextmanager
+def committed_together() -> Iterator[None]:
+    """A command's outputs appear together or not at all.
+
+    Files written inside this block through :func:`atomic_path` / :func:`atomic_paths` stay
+    temporaries until the block ends without an error; then all are renamed into place. Put the
+    command's stdout data (``--json``, the table) inside too: if that write fails (a full disk, a
+    closed stdout), no file is placed either. Nested blocks join the outermost one.
+    """
+    if _GROUP.get() is not None:
+        yield
+        return
+    pending: list = []
+    token = _GROUP.set(pending)
+    try:
+        yield
+    except BaseException:
+        for tmps, _, _ in pending:
+            _discard(tmps)
+        raise
+    finally:
+        _GROUP.reset(token)
+    _commit(pending)
+
+
+def _discard(paths: Iterable[Path]) -> None:
+    for p in paths:
+        p.unlink(missing_ok=True)
+
+
+def _commit(batches: list) -> None:
+    """fsync every temporary, then rename each onto its output; on any failure remove them all,
+    and the outputs already renamed (half a set is worse than none)."""
+    tmps = [t for batch in batches for t in batch[0]]
+    placed: list[Path] = []
+    try:
+        raise_if_interrupted()
         for tmp in tmps:
             with open(tmp, "rb+") as fh:
                 os.fsync(fh.fileno())
-        for out in outs:
-            if out.exists() and not force:  # someone else created it while we worked
-                raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
-        for tmp, out in zip(tmps, outs):
-            os.replace(tmp, out)
-            placed.append(out)
+        for _, outs, force in batches:
+            for out in outs:
+                if out.exists() and not force:  # someone else created it while we worked
+                    raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
+        for batch_tmps, outs, _ in batches:
+            for tmp, out in zip(batch_tmps, outs):
+                os.replace(tmp, out)
+                placed.append(out)
     except BaseException:
-        for tmp in tmps:
-            tmp.unlink(missing_ok=True)
-        for out in placed:  # half a pair is worse than none (a video without its ground truth)
-            out.unlink(missing_ok=True)
+        _discard(tmps)
+        _discard(placed)
         raise
 
 

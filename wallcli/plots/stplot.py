@@ -12,7 +12,8 @@ LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)
 def auto_gain(plot) -> float:
     """Gain that maps +-3 robust sigma of the signal onto the full display range."""
     s = robust_sigma(np.concatenate([plot.horizontal.ravel(), plot.vertical.ravel()]))
-    return 1.0 / (6.0 * s) if s > 0 else 1.0
+    g = 1.0 / (6.0 * s) if s > 0 else 1.0
+    return g if np.isfinite(g) else 1.0  # a spread of 1e-320 (a constant wall) is no spread
 
 
 def draw_stplot(axes, plot, *, style: str = "rgb", gain: float | None = None):

@@ -148,23 +148,38 @@ def to_arrays(plot: StPlot) -> tuple[dict[str, np.ndarray], dict]:
              "h_mean": plot.h_mean, "v_mean": plot.v_mean}, plot.meta)
 
 
+_ARRAYS = ("horizontal", "vertical", "time", "h_mean", "v_mean")
+
+
 def from_arrays(arrays: dict[str, np.ndarray], meta: dict, source: str = "file") -> StPlot:
     """Validate a loaded ``.npz`` payload: ``from_arrays(*load_npz(path, kind=FORMAT))``."""
     from wallcli.errors import WallcliError
 
-    try:
+    missing = [k for k in ("horizontal", "vertical", "time") if k not in arrays]
+    if missing:
+        raise WallcliError(f"{source} is not a complete space-time plot (missing {missing[0]!r})")
+    odd = [k for k, a in arrays.items() if k in _ARRAYS and np.asarray(a).dtype.kind not in "biuf"]
+    if odd:  # strings, complex, structured: not a plot, and a cast would fail or lose data
+        raise WallcliError(f"{source}: array {odd[0]!r} is not real numbers ({np.asarray(arrays[odd[0]]).dtype})")
+    with np.errstate(over="ignore"):  # a float64 beyond float32's range becomes inf, refused below
         h = np.asarray(arrays["horizontal"], np.float32)
         v = np.asarray(arrays["vertical"], np.float32)
         t = np.asarray(arrays["time"], np.float64)
-        hm = np.asarray(arrays.get("h_mean", np.zeros((h.shape[0], 3))), np.float32)
-        vm = np.asarray(arrays.get("v_mean", np.zeros((v.shape[0], 3))), np.float32)
-    except KeyError as exc:
-        raise WallcliError(f"{source} is not a complete space-time plot (missing {exc.args[0]!r})") from None
-    if h.ndim != 3 or v.ndim != 3 or h.shape[2] != 3 or v.shape[1:] != h.shape[1:] or t.shape != (h.shape[1],):
+    if h.ndim != 3 or v.ndim != 3 or h.shape[2] != 3 or v.shape[1:] != h.shape[1:] or t.shape != (h.shape[1],) \
+            or min(h.shape[0], v.shape[0]) < 1:
         raise WallcliError(f"{source} has inconsistent space-time plot shapes "
                            f"(horizontal {h.shape}, vertical {v.shape}, time {t.shape})")
-    if not (np.all(np.isfinite(h)) and np.all(np.isfinite(v)) and np.all(np.isfinite(t))):
+    with np.errstate(over="ignore"):
+        hm = np.asarray(arrays.get("h_mean", np.zeros((h.shape[0], 3))), np.float32)
+        vm = np.asarray(arrays.get("v_mean", np.zeros((v.shape[0], 3))), np.float32)
+    if hm.shape != (h.shape[0], 3) or vm.shape != (v.shape[0], 3):
+        raise WallcliError(f"{source} has clip means of the wrong shape (h_mean {hm.shape}, v_mean {vm.shape})")
+    if not all(np.all(np.isfinite(x)) for x in (h, v, t, hm, vm)):
         raise WallcliError(f"{source} contains non-finite values")
     if t.size > 1 and np.any(np.diff(t) <= 0):
         raise WallcliError(f"{source} has timestamps that do not increase")
+    roi = meta.get("roi")
+    if roi is not None and not (isinstance(roi, list) and len(roi) == 4
+                                and all(isinstance(x, int) and not isinstance(x, bool) for x in roi)):
+        raise WallcliError(f"{source} has a malformed roi in its metadata ({roi!r:.60})")
     return StPlot(h, v, t, hm, vm, dict(meta))
