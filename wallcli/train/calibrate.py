@@ -18,7 +18,7 @@ from wallcli.infer.card import card_path, read_card
 from wallcli.infer.confidence import fit
 from wallcli.signal.window import window_signal_db
 
-DEFAULT_EDGES = [-10.0, 0.0, 10.0]
+DEFAULT_EDGES = [0.0]  # two bands: a few hundred validation windows cannot fill more
 
 
 def score_dataset(model_path: Path, data: list[Path], *, batch: int = 128) -> dict[str, np.ndarray]:
@@ -39,16 +39,33 @@ def score_dataset(model_path: Path, data: list[Path], *, batch: int = 128) -> di
             "visibility": ds.visibility()[idx], "scenes": ds.scene_ids()[idx], "classes": model.classes}
 
 
-def calibrate(model_path: Path, data: list[Path], *, level: float, edges: list[float] | None = None) -> dict[str, Any]:
-    """Write the ``confidence`` block into the card of ``model_path``; returns the block."""
+DEFAULT_MIN_SNR_DB = -20.0
+
+
+def calibrate(model_path: Path, data: list[Path], *, level: float, edges: list[float] | None = None,
+              min_snr_db: float | None = DEFAULT_MIN_SNR_DB) -> dict[str, Any]:
+    """Write the ``confidence`` block into the card of ``model_path``; returns the block.
+
+    ``min_snr_db``: only windows whose least visible mover is at least this far from the plot's
+    noise (or that hold nobody moving) are calibrated on. A person far under the camera's noise
+    is no evidence any method can read; counting them in would make every 'nobody' undetermined
+    for ever. The card says so (``validated_range``): a decided answer is validated for people
+    whose light reaches the camera at least that strongly.
+    """
     from wallcli.io.writer import write_text_atomic
 
     edges = list(DEFAULT_EDGES if edges is None else edges)
     s = score_dataset(model_path, data)
+    if min_snr_db is not None:
+        keep = np.isnan(s["visibility"]) | (s["visibility"] >= min_snr_db)
+        s = {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in s.items()}
     block = fit(s["probs"], s["labels"], s["signal_db"], s["classes"], level=level, edges=edges)
     pred = s["probs"].argmax(1)
     right = pred == s["labels"]
     decided = np.array([_decided(block, p, db) for p, db in zip(s["probs"], s["signal_db"])])
+    block["validated_range"] = ("all windows" if min_snr_db is None else
+                                f"windows whose least visible mover is at least {min_snr_db:g} dB against the plot's "
+                                "noise (the simulator's snr_db_weakest), or where nobody moves")
     block["calibrated_on"] = {
         "datasets": [str(d) for d in data], "windows": int(len(right)),
         "accuracy": round(float(right.mean()), 4),
