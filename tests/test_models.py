@@ -89,6 +89,23 @@ def test_shipped_graphs_take_any_batch_at_opset_17_or_later(task):
 
 
 @pytest.mark.parametrize("task", ["count", "activity"])
+def test_shipped_int8_models_compute_the_same_on_every_x86_cpu(task):
+    """x86 u8s8 kernels without VNNI add pairs of products into a saturating int16 (8-bit weights
+    gave the waving example another answer on AVX2 than on AVX-512 VNNI): the shipped weights stay
+    within |w| <= 64, and onnxruntime still runs every convolution as QLinearConv (not float)."""
+    onnx = pytest.importorskip("onnx")
+    from wallcli.infer.model import shipped_model_path
+    from wallcli.train.quantize import MAX_WEIGHT, fused_convolutions, saturation_margin
+
+    path = shipped_model_path(task)
+    model = onnx.load(str(path))
+    convs = sum(n.op_type == "Conv" for n in model.graph.node)
+    assert convs == {"count": 5, "activity": 10}[task]
+    assert 0 < saturation_margin(model) <= MAX_WEIGHT
+    assert fused_convolutions(path) == (convs, 0)
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
 def test_readme_confusion_matrices_are_the_shipped_cards(task):
     """The README's matrices ('visible / all' per cell) are the cards', for the shipped version."""
     root = Path(__file__).resolve().parents[1]

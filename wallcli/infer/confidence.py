@@ -39,11 +39,25 @@ def _band_text(edges: list[float], b: int) -> str:
     return f"{lo} to {hi} dB"
 
 
+Z_ONE_SIDED_90 = 1.2816
+
+
+def wilson_lower(hits: np.ndarray, n: np.ndarray, z: float) -> np.ndarray:
+    """One-sided Wilson lower bound of a proportion hits/n."""
+    n = np.asarray(n, np.float64)
+    p = np.asarray(hits, np.float64) / np.maximum(n, 1)
+    centre = p + z * z / (2 * n)
+    spread = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+    return (centre - spread) / (1 + z * z / n)
+
+
 def fit(probs: np.ndarray, labels: np.ndarray, snr_db: np.ndarray, classes: list[Any], *, level: float,
-        edges: list[float], min_support: int = MIN_SUPPORT) -> dict[str, Any]:
+        edges: list[float], min_support: int = MIN_SUPPORT, z: float = Z_ONE_SIDED_90) -> dict[str, Any]:
     """The card's confidence block from validation windows: (n, k) probabilities, true class
     indices, measured signal (dB). For each (band, answer) the smallest threshold t such that the
-    windows answered so with p >= t are right >= ``level`` of the time and number >= min_support;
+    windows answered so with p >= t are right >= ``level`` of the time, with 90 % confidence (the
+    one-sided Wilson lower bound of their accuracy, not the accuracy itself: the lowest threshold
+    whose sample just meets the level is, by its choice, a lucky sample), and number >= min_support;
     None where no such t exists."""
     probs = np.asarray(probs, np.float64)
     labels = np.asarray(labels, np.int64)
@@ -62,7 +76,7 @@ def fit(probs: np.ndarray, labels: np.ndarray, snr_db: np.ndarray, classes: list
             # top set still meets the level (and every larger set of them does not need to)
             hits = np.cumsum(ok)
             m = np.arange(1, len(p) + 1)
-            good = (hits / m >= level) & (m >= min_support)
+            good = (wilson_lower(hits, m, z) >= level) & (m >= min_support)
             if not good.any():
                 row.append(None)
                 continue
@@ -70,7 +84,7 @@ def fit(probs: np.ndarray, labels: np.ndarray, snr_db: np.ndarray, classes: list
             row.append(round(float(p[j]), 4))
         table.append(row)
     return {"format": FORMAT, "level": level, "signal_edges_db": list(edges), "thresholds": table,
-            "min_support": min_support,
+            "min_support": min_support, "bound": f"one-sided Wilson lower bound, z = {z:g}",
             "thresholds_axes": "rows: signal bands (under the first edge, between edges, over the last); columns: "
                                "answers in the order of classes; null: never right that often"}
 
