@@ -101,7 +101,10 @@ def test_verdicts_are_what_the_commands_answer(clip_report, hostile_clip, run_cl
     section = parse(clip_report.read_text(encoding="utf-8")).by_id(task)
     label = f"{ref['label']} {'person' if ref['label'] == 1 else 'people'}" if task == "count" else ref["label"]
     verdict = section.find_all("p", class_="verdict")[0].text()
-    assert verdict.startswith(f"Clip: {label} ")
+    if ref["confident"]:
+        assert verdict.startswith(f"Clip: {label} ")
+    else:  # the page never states an answer the model cannot back
+        assert verdict.startswith(f"Clip: undetermined ({ref['reason']})") and f"answer {label}," in verdict
     assert f"probability {max(ref['probabilities']):.2f}" in verdict
     probs = table_rows(section.find_all("table", class_="probs")[0])[0]
     assert [float(p) for p in probs] == pytest.approx(ref["probabilities"], abs=6e-4)
@@ -121,8 +124,9 @@ def test_models_come_from_their_cards(clip_report):
         assert card["sha256"] in text
         vis = card["validation"]["visible"]["accuracy"]
         assert f"{100 * vis:.1f} %" in text
+        tr = card["transfer"]
+        assert f"{100 * tr['accuracy']:.1f} %" in text  # the independent renderer's figure beside
     assert "What it cannot do" in text
-    assert "the card gives none" in text  # no transfer block in the shipped cards (yet)
 
 
 def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monkeypatch):

@@ -113,8 +113,15 @@ def accuracy_note(card: dict) -> str | None:
         dec = ""
         if isinstance(tr.get("coverage"), (int, float)) and isinstance(tr.get("accuracy_decided"), (int, float)):
             dec = f"; it decided {tr['coverage']:.0%} of them and was right on {tr['accuracy_decided']:.0%} of those"
-        return (f"{card.get('name', 'model')} {card.get('version', '')}: right on {tr['accuracy']:.0%}{ci} of "
-                f"{tr['scored']} clips from an independent renderer{dec}. Rely on decided answers only; see the model card.")
+        head = (f"{card.get('name', 'model')} {card.get('version', '')}: right on {tr['accuracy']:.0%}{ci} of "
+                f"{tr['scored']} clips from an independent renderer{dec}. Rely on decided answers only.")
+        sim = _simulated_note(card)
+        return head + (f" On simulated validation: {sim}" if sim else " See the model card.")
+    sim = _simulated_note(card)
+    return f"{card.get('name', 'model')} {card.get('version', '')}: {sim}" if sim else None
+
+
+def _simulated_note(card: dict) -> str | None:
     v = card.get("validation") or {}
     vis = v.get("visible") or {}
     if not isinstance(v.get("accuracy"), (int, float)) or not isinstance(vis.get("accuracy"), (int, float)):
@@ -128,6 +135,6 @@ def accuracy_note(card: dict) -> str | None:
     others = [o.get("visible") or {} for o in v.get("other_sets") or [] if isinstance(o, dict)]
     others = [o for o in others if isinstance(o.get("accuracy"), (int, float))]
     more = "".join(f"; {o['accuracy']:.0%}{ci(o)} of visible windows on another set" for o in others)
-    return (f"{card.get('name', 'model')} {card.get('version', '')}: right on {vis['accuracy']:.0%}{ci(vis)} of "
+    return (f"right on {vis['accuracy']:.0%}{ci(vis)} of "
             f"validation windows where the people are visible (>= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
             f"{ci(v)} of all{more}; a faint or distant mover reads as nobody. See the model card.")
