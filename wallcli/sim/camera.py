@@ -75,13 +75,18 @@ def sample_camera(rng: np.random.Generator, domain: str = "base", *, nuisance_p:
         p.codec, p.crf = "libx264", int(rng.integers(8, 24 if not shifted else 28))
     p.chroma = "420" if rng.random() < 0.6 else "444"
     if rng.random() < nuisance_p:
-        p.drift = rng.uniform(0.0, 0.01)
-        p.flicker = rng.uniform(0.0, 0.004) * (rng.random() < 0.5)
-        p.mains = float(rng.choice([50.0, 60.0]))
-        p.ae_steps = int(rng.integers(0, 3))
-        p.ae_size = rng.uniform(0.005, 0.03)
-        p.shake = rng.uniform(0.0, 0.3) * (rng.random() < 0.5)
+        _nuisances(rng, p, drift=0.01, flicker=0.004, flicker_p=0.5)
     return p
+
+
+def _nuisances(rng, p: CameraParams, *, drift: float, flicker: float, flicker_p: float) -> None:
+    """Lighting and camera nuisances of one clip (up to these amplitudes), drawn in a fixed order."""
+    p.drift = rng.uniform(0.0, drift)
+    p.flicker = rng.uniform(0.0, flicker) * (rng.random() < flicker_p)
+    p.mains = float(rng.choice([50.0, 60.0]))
+    p.ae_steps = int(rng.integers(0, 3))
+    p.ae_size = rng.uniform(0.005, 0.03)
+    p.shake = rng.uniform(0.0, 0.3) * (rng.random() < 0.5)
 
 
 def _sample_wide_camera(rng) -> CameraParams:
@@ -105,12 +110,7 @@ def _sample_wide_camera(rng) -> CameraParams:
         p.codec, p.crf = "libx264", (0 if rng.random() < 0.2 else int(rng.integers(6, 26)))
     p.chroma = "420" if rng.random() < 0.6 else "444"
     if rng.random() < 0.5:
-        p.drift = rng.uniform(0.0, 0.015)
-        p.flicker = rng.uniform(0.0, 0.01) * (rng.random() < 0.6)
-        p.mains = float(rng.choice([50.0, 60.0]))
-        p.ae_steps = int(rng.integers(0, 3))
-        p.ae_size = rng.uniform(0.005, 0.03)
-        p.shake = rng.uniform(0.0, 0.3) * (rng.random() < 0.5)
+        _nuisances(rng, p, drift=0.015, flicker=0.01, flicker_p=0.6)
     return p
 
 
