@@ -45,7 +45,7 @@ def test_judge_gives_a_reason_whenever_it_does_not_decide():
     probs, truth, snr = _validation()
     block = fit(probs, truth, snr, CLASSES, level=0.95, edges=[-10.0, 0.0, 10.0])
     ok, reason = judge(block, [0.9, 0.05, 0.05], -20.0, CLASSES)
-    assert not ok and "never 95% right" in reason and "'0 people'" in reason
+    assert not ok and "never 95% right" in reason and "'0 people'" in reason and "under -10 dB" in reason
     t = block["thresholds"][3][1]
     assert judge(block, [0.0, t, 1 - t], 15.0, CLASSES)[0] is False or t >= 0.5
     ok, reason = judge(block, [0.01, 0.98, 0.01], 15.0, CLASSES)

@@ -102,11 +102,9 @@ def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]
     label = classes[k]
     what = (f"{label} person" if label == 1 else f"{label} people") if isinstance(label, int) else str(label)
     if t is None:
-        return False, (f"at {snr_db:.0f} dB of signal ({_band_text(edges, b)}) the model was never {level:.0%} "
-                       f"right when it answered '{what}' in validation")
+        return False, f"'{what}' at {snr_db:.0f} dB: never {level:.0%} right in validation ({_band_text(edges, b)})"
     if probs[k] < t:
-        return False, (f"p={probs[k]:.2f} for '{what}' at {snr_db:.0f} dB of signal; the model is {level:.0%} right "
-                       f"there only from p={t:.2f}")
+        return False, f"p={probs[k]:.3f} for '{what}' at {snr_db:.0f} dB; {level:.0%} right only from p={t:.3f}"
     return True, None
 
 
