@@ -44,12 +44,13 @@ $PY research/evaluate.py count data/val_count7 --record
 $PY research/evaluate.py activity data/val_activity4 --record
 
 # Decided or undetermined (session 12): thresholds fitted on simulated validation the models never
-# trained on (a 'wide'-domain set and the shifted sets' first halves), then the transfer figures.
+# trained on (two 'wide'-domain sets and the shifted sets' first halves), then the transfer figures.
 $W simulate --dataset 768 --task count --domain wide --placement wide --seed 22 -o data/val_wide22 --jobs "$JOBS"
+$W simulate --dataset 1024 --task count --domain wide --placement wide --seed 23 -o data/val_wide23 --jobs "$JOBS"
 $W simulate --dataset 512 --task count -o data/val_count6s --jobs "$JOBS" --seed 107 --domain shifted
 $W simulate --dataset 512 --task activity -o data/val_activity3s --jobs "$JOBS" --seed 108 --domain shifted
-$PY research/calibrate.py models/count.onnx data/val_wide22 data/val_count6s --level 0.97 --edges 0
-$PY research/calibrate.py models/activity.onnx data/val_wide22 data/val_activity3s --level 0.97 --edges 0
+$PY research/calibrate.py models/count.onnx data/val_wide22 data/val_wide23 data/val_count6s --level 0.97 --edges 0
+$PY research/calibrate.py models/activity.onnx data/val_wide22 data/val_wide23 data/val_activity3s --level 0.97 --edges 0
 mkdir -p runs
 for task in count activity; do
   $W evaluate ../shared/transfer --task "$task" --json --jobs "$JOBS" > "runs/transfer_$task.json"
