@@ -56,7 +56,8 @@ def train(
     preprocessing: str = typer.Option("v1", "--preprocessing", help="Window normalisation the net learns on, recorded "
                                       "in the card (inference follows the card): v1 = divided by the window's RMS; v2 = "
                                       "in units of the window's frame-to-frame noise, asinh-compressed, so a faint "
-                                      "second mover is not scaled away by a strong first (wallcli/signal/window.py)."),
+                                      "second mover is not scaled away by a strong first; v3 = v1 after the whole-wall light change (flicker, "
+                                      "drift) is projected out of every sample (wallcli/signal/window.py)."),
     arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the seed's nets exactly (count reads the "
                              "horizontal plot, activity both); 'lite' = both plots for either task, time averaged in "
                              "pairs and 32 channels (about a quarter of the seed count net's work; wallcli/train/nets.py)."),
