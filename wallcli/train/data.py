@@ -125,37 +125,34 @@ class ShardDataset:
         k = int(np.searchsorted(np.cumsum([len(m["shards"]) for m in self.manifests]), shard, side="right"))
         return self.relabel[k]
 
-    def labels(self) -> np.ndarray:
-        """Every window's label, as training sees it (relabelled where the dataset is)."""
+    def _per_window(self, key, shards=None) -> np.ndarray:
+        """One small array per window, read from every shard (or ``shards``): ``key(i)`` names it."""
         import zipfile
 
         out = np.zeros(self.n, np.int64)
         for i, f in enumerate(self.files):
+            if shards is not None and i not in shards:
+                continue
             try:
                 with np.load(f, allow_pickle=False) as npz:
-                    out[self.offsets[i]:self.offsets[i + 1]] = npz["activity" if self._relabelled(i) else "label"]
+                    out[self.offsets[i]:self.offsets[i + 1]] = npz[key(i)]
             except (OSError, ValueError, KeyError, zipfile.BadZipFile) as e:
                 raise WallcliError(f"{f} is not a readable shard ({e})") from None
         return out
 
+    def labels(self) -> np.ndarray:
+        """Every window's label, as training sees it (relabelled where the dataset is)."""
+        return self._per_window(lambda i: "activity" if self._relabelled(i) else "label")
+
     def usable(self, indices: np.ndarray) -> np.ndarray:
         """``indices`` without windows this task cannot use: from a relabelled count dataset,
         those with two movers (an activity net answers for one person)."""
-        import zipfile
-
         indices = np.asarray(indices, dtype=np.int64)
-        if not any(self.relabel):
+        relabelled = {i for i in range(len(self.files)) if self._relabelled(i)}
+        if not relabelled:
             return indices
-        keep = np.ones(self.n, bool)
-        for i, f in enumerate(self.files):
-            if not self._relabelled(i):
-                continue
-            try:
-                with np.load(f, allow_pickle=False) as npz:
-                    keep[self.offsets[i]:self.offsets[i + 1]] = npz["label"] <= 1
-            except (OSError, ValueError, KeyError, zipfile.BadZipFile) as e:
-                raise WallcliError(f"{f} is not a readable shard ({e})") from None
-        return indices[keep[indices]]
+        movers = self._per_window(lambda i: "label", relabelled)  # zeros elsewhere: kept
+        return indices[movers[indices] <= 1]
 
     def gather(self, idx: np.ndarray) -> dict[str, np.ndarray]:
         """Raw windows (len(idx), bins, window, 3) per input, their level offsets (OFFSETS: (len(idx),
