@@ -207,3 +207,43 @@ def test_whole_person_form_factor_matches_brute_force_union_of_spheres(d, headin
         return hit
 
     assert rendered == pytest.approx(_hemisphere_quadrature(p[0], union, n=800), rel=0.04)
+
+
+def _panel_room(L=40.0, rect=(0.4, 0.6, 0.4, 0.6)):
+    """A uniform grey room lit only by one ceiling panel (surface 4) of radiance L."""
+    from wallcli.sim.room import TEX, Room
+
+    size = np.array([5.0, 5.0, 3.0])
+    rad = np.full((5, TEX, TEX, 3), 0.1)
+    u0, u1, v0, v1 = rect
+    rad[4, int(v0 * TEX):int(v1 * TEX), int(u0 * TEX):int(u1 * TEX)] = L
+    return Room(size, np.full((5, TEX, TEX, 3), 0.5), rad, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)),
+                np.full(3, 0.3), [(4, *rect)])
+
+
+@pytest.mark.parametrize("height", [0.8, 1.6])
+def test_area_light_sources_match_the_exact_polygon_irradiance(height):
+    """The 4 x 4 point sources a panel is split into give the irradiance of Lambert's exact contour
+    integral at a point facing it (what lights a person's head under a ceiling panel)."""
+    from wallcli.sim.room import area_irradiance, surface_uv_to_xyz
+
+    room = _panel_room()
+    p = np.array([[2.3, 2.6, 3.0 - height]])  # below the panel, off its centre
+    E, _ = area_irradiance(room.sources, p, np.array([[0.0, 0.0, 1.0]]))
+    poly = surface_uv_to_xyz(room.size, 4, np.array([0.4, 0.6, 0.6, 0.4]), np.array([0.4, 0.4, 0.6, 0.6]))
+    exact = np.pi * 40.0 * polygon_form_factor(p, np.array([0.0, 0.0, 1.0]), poly[None])[0, 0]
+    assert E.sum(axis=1)[0, 1] == pytest.approx(exact, rel=0.04)
+
+
+def test_a_person_under_a_ceiling_panel_is_lit_by_it():
+    """Bodies take direct light from windows and panels, not only the room's ambient light: under
+    a bright panel a raised hand is far brighter than one held low, and brighter than ambient alone."""
+    from wallcli.sim.room import body_radiance
+
+    room = _panel_room()
+    albedo = np.full((2, 3), 0.5)
+    centres = np.array([[2.5, 2.5, 2.5], [2.5, 2.5, 0.8]])  # a hand overhead, a hand by the hip
+    L = body_radiance(room, centres, albedo, np.array([2.5, 0.0, 1.5]))[:, 1]
+    ambient_only = 0.5 * 0.3 / np.pi
+    assert L[1] > 1.5 * ambient_only
+    assert L[0] > 4 * L[1]

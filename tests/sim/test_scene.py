@@ -104,3 +104,22 @@ def test_static_irradiance_subgrid_matches_exact():
         s = sample_scene(seed, SceneConfig(people=0, grid=(32, 32), duration=0.2))
         exact = static_irradiance(s.room, s.points.reshape(-1, 3)).reshape(s.points.shape)
         np.testing.assert_allclose(s.static_irradiance(), exact, rtol=0.01)
+
+
+def test_wide_waving_and_jumping_add_whole_arm_motion():
+    """The 'wide' domain also waves whole arms from the shoulder and throws arms overhead in
+    jumps (larger motions people make); the base domain keeps the seed's forearm wave."""
+    t = np.arange(0, 12, 1 / 30)
+    spans = {}
+    for domain in ("base", "wide"):
+        swings = overhead = 0
+        for seed in range(40):
+            rng = np.random.default_rng(seed)
+            wave = motion.make_motion(rng, "waving", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
+            jump = motion.make_motion(rng, "jumping", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
+            # a whole-arm wave sweeps the arm's elevation by over a radian at the waving rate
+            swings += np.ptp(np.diff(wave["arm_abduct"], axis=0)) > 0.05 and not np.any(wave["wave"])
+            overhead += jump["arm_abduct"].max() > 1.5
+        spans[domain] = (swings, overhead)
+    assert spans["base"] == (0, 0)
+    assert spans["wide"][0] >= 10 and spans["wide"][1] >= 10

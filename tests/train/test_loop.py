@@ -143,3 +143,13 @@ def test_superpose_adds_windows_and_their_counts():
     # two-person windows take no partner but an empty one; nothing exceeds two people
     assert np.all(out["label"][b["label"] == 2] == 2)
     assert np.array_equal(superpose(b, ["horizontal"], np.random.default_rng(3), p=0.0)["label"], b["label"])
+
+
+def test_train_refuses_a_device_it_cannot_use(tmp_path, run_cli):
+    code, _, err = run_cli("train", "count", "--data", tmp_path, "--out", tmp_path / "m.onnx", "--device", "tpu")
+    assert code == 2 and "--device must be cpu or cuda" in err
+    import torch
+
+    if not torch.cuda.is_available():
+        code, _, err = run_cli("train", "count", "--data", tmp_path, "--out", tmp_path / "m.onnx", "--device", "cuda")
+        assert code == 2 and "sees no CUDA GPU" in err

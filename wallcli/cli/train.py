@@ -73,6 +73,8 @@ def train(
                                         "task (its .onnx, float or int8): fine-tuning. The card records which."),
     lr: float = number_option(1e-3, "--lr", lo=1e-7, hi=1, help="RMSProp learning rate (the seed's 1e-3; "
                              "--anneal ends at 1/100 of it). Lower it to fine-tune from --init."),
+    device: str = typer.Option("cpu", "--device", help="Where the net trains: 'cpu', or 'cuda' on a machine with an "
+                               "NVIDIA GPU and a CUDA build of PyTorch (batches are still read and augmented on the CPU)."),
     force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
@@ -125,6 +127,10 @@ def train(
     if arch not in ARCHS:
         raise UsageError(f"--arch must be {' or '.join(ARCHS)} (got {arch!r})")
     prep = versions[preprocessing]
+    if device not in ("cpu", "cuda"):
+        raise UsageError(f"--device must be cpu or cuda (got {device!r})")
+    if device == "cuda" and not torch.cuda.is_available():
+        raise UsageError("--device cuda: this PyTorch sees no CUDA GPU", hint="train with --device cpu")
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     check_outputs([out, card_path(out)], force=force)
@@ -146,7 +152,7 @@ def train(
                       batch_size=batch_size, threads=threads, seed=seed, checkpoint=checkpoint,
                       checkpoint_minutes=checkpoint_minutes, resume=resume, augment=augment,
                       min_snr_db=min_snr_db, ema=ema, select=select, superpose=superpose, preprocessing=prep,
-                      anneal=anneal, init=init, lr=lr, arch=arch, balance=balance)
+                      anneal=anneal, init=init, lr=lr, arch=arch, balance=balance, device=device)
 
     # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1): wallcli.cli._signals,
     # installed by main(), turns both into wallcli.errors.Interrupted, which run_training catches.

@@ -7,8 +7,9 @@ deep squat), bob (hip height offset / scale), lift (whole-body height offset, ju
 
 Activities (the classes): none (standing still: breathing-scale sway only), walking (waypoint
 paths at 0.5-1.8 m/s with smooth turns and stops), crouching (squat down/hold/up bouts),
-waving (one or both arms raised, forearm oscillating 1-3 Hz, in bouts), jumping (pre-crouch,
-ballistic flight of 5-40 cm, landing, pauses).
+waving (one or both arms raised, forearm oscillating 1-3 Hz, in bouts; 'wide' also whole arms
+swinging from the shoulder), jumping (pre-crouch, ballistic flight of 5-40 cm, 'wide' up to 50 cm
+and arms overhead, landing, pauses).
 """
 
 from __future__ import annotations
@@ -136,14 +137,28 @@ def crouching(rng, t, spot):
     return pose
 
 
-def waving(rng, t, spot):
+def waving(rng, t, spot, domain: str = "base"):
+    """A raised arm waving its forearm (hello), or, in the 'wide' domain, as often a whole arm or
+    both swinging from the shoulder between hip and overhead (signalling, cheering): the larger
+    motion that people also make and that changes a wall's light many times more."""
     pose = standing(rng, t, spot)
-    both = rng.random() < 0.35
+    both = rng.random() < (0.5 if domain == "wide" else 0.35)
     side = int(rng.integers(0, 2))
+    on = _smooth(_bouts(rng, t, (2.0, 7.0), (0.3, 2.0)), 0.5 / max(t[1] - t[0], 1e-3))
+    if domain == "wide" and rng.random() < 0.55:
+        freq = rng.uniform(0.6, 2.5)
+        lo, hi = rng.uniform(0.15, 1.4), rng.uniform(2.2, 3.0)
+        phase = rng.uniform(0, 2 * np.pi)
+        for k in (0, 1):
+            if both or k == side:
+                swing = lo + (hi - lo) * (0.5 - 0.5 * np.cos(2 * np.pi * freq * t + phase + (k * np.pi if rng.random() < 0.2 else 0)))
+                pose["arm_abduct"][:, k] = 0.08 + on * (swing - 0.08)
+                pose["arm_swing"][:, k] = on * rng.uniform(-0.3, 0.6)
+                pose["elbow"][:, k] = 0.15 + on * rng.uniform(0.0, 0.4)
+        return pose
     freq = rng.uniform(1.0, 3.0)
     amp = rng.uniform(0.25, 0.7)
     raise_to = rng.uniform(2.0, 2.9)
-    on = _smooth(_bouts(rng, t, (2.0, 7.0), (0.3, 2.0)), 0.5 / max(t[1] - t[0], 1e-3))
     for k in (0, 1):
         if both or k == side:
             pose["arm_abduct"][:, k] = 0.08 + on * (raise_to - 0.08)
@@ -152,11 +167,15 @@ def waving(rng, t, spot):
     return pose
 
 
-def jumping(rng, t, spot):
+def jumping(rng, t, spot, domain: str = "base"):
+    """Jumps in place; in the 'wide' domain also higher, and half the time with the arms thrown
+    overhead (jumping jacks, a cheer) instead of swung forward."""
     pose = standing(rng, t, spot)
     c, lift, arms = np.zeros(len(t)), np.zeros(len(t)), np.zeros(len(t))
     now = t[0] - rng.uniform(0, 2)
-    height_base = rng.uniform(0.06, 0.4)
+    wide = domain == "wide"
+    height_base = rng.uniform(0.06, 0.5 if wide else 0.4)
+    overhead = wide and rng.random() < 0.5
     while now < t[-1]:
         prep, land = rng.uniform(0.2, 0.45), rng.uniform(0.15, 0.35)
         h = height_base * rng.uniform(0.7, 1.2)
@@ -175,11 +194,15 @@ def jumping(rng, t, spot):
         now += prep + fly + land + (rng.uniform(0.05, 0.6) if rng.random() < 0.6 else rng.uniform(0.6, 2.5))
     pose["crouch"], pose["lift"] = c, lift
     pose["lean"] = 0.5 * c
-    pose["arm_swing"] = arms[:, None] * np.ones(2)
+    if overhead:  # arms from the sides to overhead in flight, back down on landing
+        pose["arm_abduct"] = 0.08 + (np.clip(arms, 0, None) / 1.2 * rng.uniform(1.8, 2.9))[:, None] * np.ones(2)
+    else:
+        pose["arm_swing"] = arms[:, None] * np.ones(2)
     return pose
 
 
-def make_motion(rng, activity: str, t: np.ndarray, bounds, speed=(0.5, 1.8), cross: int = 0) -> dict:
+def make_motion(rng, activity: str, t: np.ndarray, bounds, speed=(0.5, 1.8), cross: int = 0,
+                domain: str = "base") -> dict:
     """Pose tracks for one person doing ``activity`` inside bounds ((x0, x1), (y0, y1))."""
     (x0, x1), (y0, y1) = bounds
     spot = (rng.uniform(x0, x1), rng.uniform(y0, y1))
@@ -187,4 +210,6 @@ def make_motion(rng, activity: str, t: np.ndarray, bounds, speed=(0.5, 1.8), cro
         return walking(rng, t, bounds, speed, cross)
     if activity == "none":
         return standing(rng, t, spot)
-    return {"crouching": crouching, "waving": waving, "jumping": jumping}[activity](rng, t, spot)
+    if activity == "crouching":
+        return crouching(rng, t, spot)
+    return {"waving": waving, "jumping": jumping}[activity](rng, t, spot, domain)

@@ -3,9 +3,10 @@
 Model (units arbitrary but consistent; a uniform surround of radiance L gives E = pi L):
 - Surfaces 0..4 (left x=0, right x=W, back y=D, floor z=0, ceiling z=H) are Lambertian with
   albedo textures. Their radiance is rho * (E_direct + E_ambient) / pi; E_direct comes from the
-  lamps (small emitting spheres, exact sphere form factor), E_ambient is the closed-box radiosity
-  estimate rho_mean * flux / (area * (1 - rho_mean)) that stands in for all further bounces.
-  Windows are emitting rectangles painted into the wall radiance maps.
+  lamps (small emitting spheres, exact sphere form factor) and the windows and ceiling panels
+  (each split into 4 x 4 point sources), E_ambient is the closed-box radiosity estimate
+  rho_mean * flux / (area * (1 - rho_mean)) that stands in for all further bounces.
+  Windows and panels are emitting rectangles painted into the surface radiance maps.
 - The observed wall (y = 0) receives E_static(x) = lamps (exact sphere form factors) + the five
   surfaces, integrated as piecewise-constant patches with exact polygon form factors (Lambert).
 - Bodies are spheres. Each changes a wall point's irradiance by exactly
@@ -20,8 +21,8 @@ Model (units arbitrary but consistent; a uniform surround of radiance L gives E 
   sub-grid of the wall and interpolated; whole bodies match brute-force ray casting within ~2.5 %
   at 1 m, see tests/sim/test_physics.py); bodies do not shadow
   the other room surfaces (a second-order effect on the observed wall); body radiance uses one
-  view direction (to the centre of the observed patch) and ambient + lamp light without
-  self-shadowing.
+  view direction (to the centre of the observed patch) and ambient + lamp + window/panel light
+  without self-shadowing.
 """
 
 from __future__ import annotations
@@ -48,15 +49,60 @@ class Room:
     ambient: np.ndarray  # (3,) ambient irradiance used for bodies and surfaces
     windows: list = field(default_factory=list)  # [(surface, u0, u1, v0, v1)] for previews
     radiance_blur: np.ndarray = None  # radiance maps blurred by ~15 cm: the mean behind a body sphere
+    # windows and ceiling panels as point sources that light the bodies: positions (S, 3), inward
+    # normals (S, 3), radiance x area (S, 3); see area_sources()
+    sources: tuple = None
 
     def __post_init__(self):
         if self.radiance_blur is None:
             self.radiance = self.radiance.astype(np.float32)
             self.radiance_blur = _blur(self.radiance, max(1, int(round(0.15 / (self.size.max() / TEX)))))
+        if self.sources is None:
+            self.sources = area_sources(self.size, self.windows, self.radiance)
 
     @property
     def lamp_intensity(self) -> np.ndarray:
         return self.lamp_radiance * (np.pi * self.lamp_radius**2)[:, None]
+
+
+AREA_SPLIT = 4  # an area light is lit from as AREA_SPLIT x AREA_SPLIT point sources
+
+
+def area_sources(size, windows, radiance) -> tuple:
+    """Windows and ceiling panels as AREA_SPLIT^2 point sources each: (positions, normals, L*A).
+
+    A person under a ceiling panel or beside a window is lit by it directly, and far more than by
+    the room's ambient light: a raised arm near a panel is one of the brightest things in the room.
+    Each sub-rectangle's radiance is read back from the radiance maps (windows are painted there)."""
+    W, D, H = (float(v) for v in size)
+    area = np.array([D * H, D * H, W * H, W * D, W * D])
+    pos, nrm, power = [], [], []
+    k = AREA_SPLIT
+    for s, u0, u1, v0, v1 in windows:
+        du, dv = (u1 - u0) / k, (v1 - v0) / k
+        for j in range(k):
+            for i in range(k):
+                a, b = u0 + i * du, v0 + j * dv
+                iu = slice(int(a * TEX), max(int(a * TEX) + 1, int((a + du) * TEX)))
+                iv = slice(int(b * TEX), max(int(b * TEX) + 1, int((b + dv) * TEX)))
+                pos.append(surface_uv_to_xyz(size, s, a + du / 2, b + dv / 2))
+                nrm.append(NORMALS[s])
+                power.append(radiance[s, iv, iu].reshape(-1, 3).mean(axis=0) * du * dv * area[s])
+    if not pos:
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3))
+    return np.array(pos, float), np.array(nrm, float), np.array(power, float)
+
+
+def area_irradiance(sources: tuple, points: np.ndarray, normals: np.ndarray | None = None) -> tuple:
+    """Direct irradiance (N, S, 3) of each area-light point source at points, on a surface of
+    the given normals (N, 3) or, with None, facing the source; and the unit directions (N, S, 3)."""
+    pos, nrm, power = sources
+    d = pos[None] - points[:, None]
+    r2 = np.maximum(np.einsum("nsk,nsk->ns", d, d), 1e-6)
+    u = d / np.sqrt(r2)[..., None]
+    emit = np.clip(-np.einsum("nsk,sk->ns", u, nrm), 0, None)  # the source's cos toward the point
+    recv = 1.0 if normals is None else np.clip(np.einsum("nsk,nk->ns", u, normals), 0, None)
+    return power[None] * (emit * recv / r2)[..., None], u
 
 
 def _blur(maps: np.ndarray, k: int) -> np.ndarray:
@@ -228,6 +274,15 @@ def _sample_room(rng, domain, W, D, H) -> Room:
         window_rad[s, iv, iu] = L * grad[..., None]
         window_flux += np.pi * L * (wu * wv * area[s])
         windows.append((s, u0, u0 + wu, v0, v0 + wv))
+    # windows and panels light the room's surfaces directly too (a bright pool on the floor under a
+    # panel, a sunlit strip of wall), not only through the ambient estimate
+    sources = area_sources(size, windows, window_rad)
+    if len(sources[0]):
+        cap = np.pi * window_rad.reshape(-1, 3).max(axis=0)  # no surface gets more than a sky of it
+        for s in range(5):
+            p = surface_uv_to_xyz(size, s, uu, vv).reshape(-1, 3)
+            E, _ = area_irradiance(sources, p, np.broadcast_to(NORMALS[s], p.shape))
+            direct[s] += np.minimum(E.sum(axis=1), cap).reshape(TEX, TEX, 3)
     rho_mean = float(np.average(albedo.mean(axis=(1, 2, 3)), weights=area))
     lamp_flux = 4 * np.pi * (lamp_rad * (np.pi * lamp_radius**2)[:, None]).sum(axis=0)
     ambient = rho_mean * (lamp_flux + window_flux) / (area.sum() + W * H) / (1 - rho_mean)
@@ -319,6 +374,10 @@ def body_radiance(room: Room, centers: np.ndarray, albedo: np.ndarray, view: np.
         cos_a = np.einsum("mk,mk->m", d, to_view) / np.sqrt(r2)
         e = np.pi * room.lamp_radiance[k][None] * (room.lamp_radius[k] ** 2 / r2 * lambert_sphere_phase(np.arccos(np.clip(cos_a, -1, 1))))[:, None]
         L += e / np.pi
+    if room.sources is not None and len(room.sources[0]):
+        E, u = area_irradiance(room.sources, centers)  # (M, S, 3): each sub-source lights the sphere's facing side
+        phase = lambert_sphere_phase(np.arccos(np.clip(np.einsum("msk,mk->ms", u, to_view), -1, 1)))
+        L += np.einsum("msc,ms->mc", E, phase) / np.pi
     return albedo * L
 
 

@@ -213,6 +213,7 @@ def sample_scene(seed: int, config: SceneConfig | None = None, index: int | None
     people, poses = [], []
     for i, a in enumerate(acts):
         people.append(bodies.sample_person(rng, config.domain))
-        poses.append(motion.make_motion(rng, a, times, bounds if a == "walking" else spot_bounds, config.speed, cross.get(i, 0)))
+        poses.append(motion.make_motion(rng, a, times, bounds if a == "walking" else spot_bounds, config.speed, cross.get(i, 0),
+                                        config.domain))
     return Scene(int(seed), config, room, cam, region, points,
                  people, acts, poses, times, rng)

@@ -83,6 +83,7 @@ class TrainConfig:
     init: Path | None = None  # an exported model (.onnx) whose weights training starts from
     arch: str = "seed"  # wallcli.train.nets.ARCHS
     balance: bool = False  # weight the loss by inverse class frequency of the training windows
+    device: str = "cpu"  # torch device of the net and its batches ("cuda" on a GPU machine); results do not depend on it beyond float rounding
 
     def checkpoint_path(self) -> Path:
         return Path(self.checkpoint) if self.checkpoint else Path(self.out).with_suffix(".ckpt.pt")
@@ -97,7 +98,7 @@ def _to_tensor(x: np.ndarray, channels_last: bool, preprocessing: str = NORMALIZ
 
 
 def evaluate(net: nn.Module, ds: ShardDataset, indices: np.ndarray, batch_size: int,
-             channels_last: bool = False, preprocessing: str = NORMALIZATION) -> dict[str, Any]:
+             channels_last: bool = False, preprocessing: str = NORMALIZATION, device: str = "cpu") -> dict[str, Any]:
     """Accuracy, mean loss and confusion matrix (rows: true class, columns: predicted)."""
     k = len(ds.classes)
     cm = np.zeros((k, k), np.int64)
@@ -107,10 +108,10 @@ def evaluate(net: nn.Module, ds: ShardDataset, indices: np.ndarray, batch_size: 
     with torch.no_grad():
         for idx in ds.plan(indices, batch_size, np.random.default_rng(0), shuffle=False):
             b = ds.gather(idx)
-            logits = net(*[_to_tensor(b[n], channels_last, preprocessing, b.get(OFFSETS[n])) for n in ds.inputs])
-            y = torch.from_numpy(b["label"])
+            logits = net(*[_to_tensor(b[n], channels_last, preprocessing, b.get(OFFSETS[n])).to(device) for n in ds.inputs])
+            y = torch.from_numpy(b["label"]).to(device)
             loss_sum += float(nn.functional.cross_entropy(logits, y, reduction="sum"))
-            np.add.at(cm, (b["label"], logits.argmax(1).numpy()), 1)
+            np.add.at(cm, (b["label"], logits.argmax(1).cpu().numpy()), 1)
     net.train(was_training)
     n = int(cm.sum())
     return {"windows": n, "accuracy": float(np.trace(cm) / n) if n else float("nan"),
@@ -176,6 +177,8 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         pick = np.sort(np.random.default_rng([cfg.seed, 0x1417]).choice(train_idx, min(64, len(train_idx)), replace=False))
         b = ds.gather(pick)
         init_from_onnx(net, cfg.init, [_to_tensor(b[n], False, cfg.preprocessing, b.get(OFFSETS[n])) for n in ds.inputs])
+    dev = torch.device(cfg.device)
+    net = net.to(dev)
     if cfg.channels_last:
         net = net.to(memory_format=torch.channels_last)
     opt = torch.optim.RMSprop(net.parameters(), lr=cfg.lr)
@@ -184,7 +187,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         # a rare class (waving, jumping: few of them visible) must not be traded for the common one
         counts = np.bincount(ds.labels()[train_idx], minlength=len(ds.classes)).astype(np.float64)
         weight = torch.tensor(np.where(counts > 0, counts.sum() / (len(counts) * np.maximum(counts, 1)), 0.0),
-                              dtype=torch.float32)
+                              dtype=torch.float32, device=dev)
     loss_fn = nn.CrossEntropyLoss(weight=weight)
     ident = _identity(cfg, ds)
     epoch, start_batch, history, step = 0, 0, [], 0
@@ -203,7 +206,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         epoch, start_batch, history, best = ck["epoch"], ck["batch"], ck["history"], ck["best"]
         step = ck.get("step", 0)
         if ema is not None:
-            ema = ck["ema"]
+            ema = {k: v.to(dev) for k, v in ck["ema"].items()}
         emit("resume", epoch=epoch, batch=start_batch, path=ckpt_path)
 
     def checkpoint(ep: int, batch: int) -> None:
@@ -229,8 +232,9 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
                     b = superpose(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0x5AB]), cfg.superpose)
                 if cfg.augment:
                     b = augment(b, ds.inputs, np.random.default_rng([cfg.seed, epoch, bi, 0xA06]))
-                xs = [_to_tensor(b[n], cfg.channels_last, cfg.preprocessing, b.get(OFFSETS[n])) for n in ds.inputs]
-                y = torch.from_numpy(b["label"])
+                xs = [_to_tensor(b[n], cfg.channels_last, cfg.preprocessing, b.get(OFFSETS[n])).to(dev, non_blocking=True)
+                      for n in ds.inputs]
+                y = torch.from_numpy(b["label"]).to(dev)
                 for g in opt.param_groups:
                     g["lr"] = learning_rate(cfg, epoch, bi, len(batches))
                 opt.zero_grad(set_to_none=True)
@@ -260,7 +264,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
         if ema is not None:
             eval_net = copy.deepcopy(net)
             eval_net.load_state_dict(ema)
-        val = (evaluate(eval_net, val_ds, val_idx, max(cfg.batch_size, 64), cfg.channels_last, cfg.preprocessing)
+        val = (evaluate(eval_net, val_ds, val_idx, max(cfg.batch_size, 64), cfg.channels_last, cfg.preprocessing, dev)
                if len(val_idx) else None)
         rec = {"epoch": epoch + 1, "train_loss": loss_sum / seen if seen else None,
                "train_accuracy": correct / seen if seen else None, "lr_end": opt.param_groups[0]["lr"], "train_windows_per_s": seen / max(time.monotonic() - t0, 1e-9),
@@ -276,6 +280,7 @@ def train(cfg: TrainConfig, on_event: Event | None = None) -> dict[str, Any]:
 
     if best["state"] is not None:
         net.load_state_dict(best["state"])
+    net = net.to("cpu")  # export, quantisation and the card's evaluation run on the CPU
     net.eval()
     return {"net": net, "dataset": ds, "val_dataset": val_ds if cfg.val is not None else None,
             "validation": best["validation"], "best_epoch": best["epoch"], "history": history,
