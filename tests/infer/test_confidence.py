@@ -41,6 +41,32 @@ def test_fitted_thresholds_meet_the_level_where_they_exist():
     assert (p2.argmax(1) == t2)[d2].mean() > 0.92
 
 
+def test_a_threshold_must_hold_in_every_validation_set_on_its_own():
+    """A large set where confident answers are right must not carry a threshold over a smaller
+    set (another simulated world) where the same confident answers are often wrong."""
+    rng = np.random.default_rng(0)
+    p_easy = rng.uniform(0.5, 1.0, 2000)
+    t_easy = np.where(p_easy > 0.6, 0, 1)  # easy world: 'nobody' is right whenever p > 0.6
+    p_hard = rng.uniform(0.9, 1.0, 100)
+    t_hard = np.where(rng.random(100) < 0.5, 0, 1)  # hard world: confident 'nobody' is a coin toss
+    pm = np.r_[p_easy, p_hard]
+    P = np.stack([pm, 1 - pm, np.zeros_like(pm)], 1)
+    T, S = np.r_[t_easy, t_hard], np.zeros(len(pm))
+    groups = np.r_[np.zeros(2000), np.ones(100)]
+    pooled = fit(P, T, S, CLASSES, level=0.95, edges=[10.0])
+    per_set = fit(P, T, S, CLASSES, level=0.95, edges=[10.0], groups=groups)
+    assert validate_block(per_set, 3) is None and "per_set" in per_set
+    hard = groups == 1
+
+    def decided(block):
+        return np.array([judge(block, p, s, CLASSES)[0] for p, s in zip(P[hard], S[hard])])
+
+    assert decided(pooled).sum() > 80  # pooled, the easy world vouches for the hard one's coin tosses
+    assert decided(per_set).sum() < 25  # per set, only where too few of the hard world's answers remain
+    t = per_set["thresholds"][0][0]
+    assert t is None or t > pooled["thresholds"][0][0]
+
+
 def test_judge_gives_a_reason_whenever_it_does_not_decide():
     probs, truth, snr = _validation()
     block = fit(probs, truth, snr, CLASSES, level=0.95, edges=[-10.0, 0.0, 10.0])

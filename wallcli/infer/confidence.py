@@ -52,31 +52,42 @@ def wilson_lower(hits: np.ndarray, n: np.ndarray, z: float) -> np.ndarray:
 
 
 def fit(probs: np.ndarray, labels: np.ndarray, snr_db: np.ndarray, classes: list[Any], *, level: float,
-        edges: list[float], min_support: int = MIN_SUPPORT, z: float = Z_ONE_SIDED_90) -> dict[str, Any]:
+        edges: list[float], min_support: int = MIN_SUPPORT, z: float = Z_ONE_SIDED_90,
+        groups: np.ndarray | None = None) -> dict[str, Any]:
     """The card's confidence block from validation windows: (n, k) probabilities, true class
     indices, measured signal (dB). For each (band, answer) the smallest threshold t such that the
     windows answered so with p >= t are right >= ``level`` of the time, with 90 % confidence (the
     one-sided Wilson lower bound of their accuracy, not the accuracy itself: the lowest threshold
     whose sample just meets the level is, by its choice, a lucky sample), and number >= min_support;
-    None where no such t exists."""
+    None where no such t exists.
+
+    ``groups`` (n,): which validation set (simulator, domain) each window comes from. A threshold
+    must then also hold in every set on its own: in each set with at least min_support windows
+    above it, those are right >= ``level`` of the time. Pooling lets a large easy set hide a
+    small hard one; a decision that fails in one simulated world is a decision that may fail in a
+    room none of them drew."""
     probs = np.asarray(probs, np.float64)
     labels = np.asarray(labels, np.int64)
     pred = probs.argmax(1)
     pmax = probs.max(1)
     bands = np.array([band_of(edges, s) for s in snr_db])
+    grp = np.zeros(len(labels), np.int64) if groups is None else np.asarray(groups)
     table = []
     for b in range(len(edges) + 1):
         row = []
         for c in range(len(classes)):
             sel = (bands == b) & (pred == c)
-            p, ok = pmax[sel], (labels[sel] == c)
-            order = np.argsort(-p)
-            p, ok = p[order], ok[order]
+            p, ok, g = pmax[sel], (labels[sel] == c), grp[sel]
+            order = np.argsort(-p, kind="stable")
+            p, ok, g = p[order], ok[order], g[order]
             # precision of the top-m answers for every m; the threshold is the lowest p whose
             # top set still meets the level (and every larger set of them does not need to)
             hits = np.cumsum(ok)
             m = np.arange(1, len(p) + 1)
             good = (wilson_lower(hits, m, z) >= level) & (m >= min_support)
+            for u in np.unique(g) if groups is not None else []:
+                n_u, h_u = np.cumsum(g == u), np.cumsum((g == u) & ok)
+                good &= (n_u < min_support) | (h_u >= level * n_u)
             if not good.any():
                 row.append(None)
                 continue
@@ -85,6 +96,8 @@ def fit(probs: np.ndarray, labels: np.ndarray, snr_db: np.ndarray, classes: list
         table.append(row)
     return {"format": FORMAT, "level": level, "signal_edges_db": list(edges), "thresholds": table,
             "min_support": min_support, "bound": f"one-sided Wilson lower bound, z = {z:g}",
+            **({} if groups is None else {"per_set": f"and >= level in each of the {len(np.unique(grp))} validation "
+                                                    f"sets on its own (where >= min_support windows)"}),
             "thresholds_axes": "rows: signal bands (under the first edge, between edges, over the last); columns: "
                                "answers in the order of classes; null: never right that often"}
 

@@ -55,11 +55,15 @@ def calibrate(model_path: Path, data: list[Path], *, level: float, edges: list[f
     from wallcli.io.writer import write_text_atomic
 
     edges = list(DEFAULT_EDGES if edges is None else edges)
-    s = score_dataset(model_path, data)
+    parts = [score_dataset(model_path, [d]) for d in data]  # scored apart: each set is also checked alone
+    s = {k: (np.concatenate([p[k] for p in parts]) if isinstance(parts[0][k], np.ndarray) else parts[0][k])
+         for k in parts[0]}
+    s["group"] = np.concatenate([np.full(len(p["labels"]), i) for i, p in enumerate(parts)])
     if min_snr_db is not None:
         keep = np.isnan(s["visibility"]) | (s["visibility"] >= min_snr_db)
         s = {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in s.items()}
-    block = fit(s["probs"], s["labels"], s["signal_db"], s["classes"], level=level, edges=edges)
+    block = fit(s["probs"], s["labels"], s["signal_db"], s["classes"], level=level, edges=edges,
+                groups=s["group"] if len(data) > 1 else None)
     pred = s["probs"].argmax(1)
     right = pred == s["labels"]
     decided = np.array([_decided(block, p, db) for p, db in zip(s["probs"], s["signal_db"])])
