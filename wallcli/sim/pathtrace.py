@@ -20,7 +20,10 @@ observed wall points) is path traced instead:
 Every frame is rendered with the same sampler seed: a path that never meets a person draws the
 same random numbers and finds the same surfaces every frame, so the static room cancels exactly
 in E(t) - E_empty (correlated sampling) and only paths that touch a person carry Monte Carlo
-noise. ``max_depth`` 4 = light that reached the wall after up to three bounces.
+noise. ``max_depth`` 4 = light that reached the wall after up to three bounces. The sampler is
+multi-jittered: on a walker 1.5 m from the wall (24 x 32 points, 256 spp) the Monte Carlo noise of
+the column profiles of dE / E is 1.7 per mille against 6.2 for independent samples at the same
+cost (0.7 per mille at 1024 spp; the walker's own signal there is ~20-40 per mille).
 
 Mitsuba is optional (``pip install 'wallcli[pt]'``) and imported only here, inside functions.
 Variant: ``WALLCLI_PT_VARIANT`` if set, else cuda_ad_rgb where a CUDA device works, else
@@ -196,7 +199,7 @@ class PathTracer:
     """Renders the wall irradiance (gy, gx, 3) of a room with box people, one frame at a time."""
 
     def __init__(self, room: Room, points: np.ndarray, people: list, poses: list, *, spp: int = 256,
-                 max_depth: int = 4, seed: int = 0, textures: bool = True):
+                 max_depth: int = 4, seed: int = 0, textures: bool = True, sampler: str = "multijitter"):
         mi = self.mi = mitsuba()
         self.points = np.asarray(points, float)
         self.spp, self.seed = int(spp), int(seed)
@@ -218,7 +221,7 @@ class PathTracer:
              "sensor": {"type": "orthographic", "near_clip": 1e-4, "far_clip": 1.0, "to_world": cam,
                         "film": {"type": "hdrfilm", "width": gx, "height": gy, "rfilter": {"type": "box"},
                                  "pixel_format": "rgb", "component_format": "float32", "sample_border": False},
-                        "sampler": {"type": "independent", "sample_count": self.spp, "seed": self.seed}}}
+                        "sampler": {"type": sampler, "sample_count": self.spp, "seed": self.seed}}}
         black = {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}
         for s in range(5):
             if textures:
