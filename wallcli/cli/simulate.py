@@ -54,7 +54,12 @@ def simulate(
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality for .mp4 (0 = lossless, 18 = visually clean, 28 = "
                             "strong compression that erases faint signals)."),
     world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the seed's 2-D world "
-                              "(people = 1-2 moving occluders, horizontal information only)."),
+                              "(people = 1-2 moving occluders, horizontal information only); pt: the same rooms and "
+                              "motions path traced by Mitsuba 3 (people of boxes, three bounces; needs "
+                              "pip install 'wallcli[pt]'; slow on a CPU, meant for a GPU); mixed (--dataset only): room "
+                              "with some flatland count scenes."),
+    spp: int = number_option(256, "--spp", lo=1, hi=65536, integer=True, help="--world pt: path-traced samples per wall point "
+                             "and frame (Monte Carlo noise in the people's signal falls as 1/sqrt(spp))."),
     domain: str = typer.Option("base", "--domain", help="base: training ranges; shifted: moved ranges of room size, lights, "
                                "clothing, body size, camera (an honest held-out validation set)."),
     distance: str = typer.Option("1,5", "--distance", help="MIN,MAX distance of people from the wall (m)."),
@@ -86,7 +91,8 @@ def simulate(
     task: str = typer.Option("count", "--task", help="Dataset labels: count (0/1/2 people, every activity, mixed pairs) or "
                              "activity (none/walking/crouching/waving/jumping)."),
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
-                              help="Dataset worker processes (0 = one per core; at most 4 per core)."),
+                              help="Dataset worker processes (0 = one per core, or 1 with --world pt, whose "
+                              "renderer uses every core itself; at most 4 per core)."),
     windows_per_scene: int = number_option(4, "--windows-per-scene", lo=1, hi=16, integer=True, help="Overlapping windows cut from each rendered clip."),
     shard_scenes: int = number_option(32, "--shard-scenes", lo=1, hi=100_000, integer=True, help="Scenes per shard file."),
     placement: str = typer.Option("visible", "--placement", help="Dataset mode: where people go. visible: 0.8-4 m from the "
@@ -110,8 +116,8 @@ def simulate(
     """
     from wallcli.errors import UsageError
 
-    if world not in ("room", "flatland", "mixed"):
-        raise UsageError(f"--world must be room, flatland or mixed (got {world!r})")
+    if world not in ("room", "flatland", "mixed", "pt"):
+        raise UsageError(f"--world must be room, flatland, pt or mixed (got {world!r})")
     if domain not in ("base", "shifted", "wide"):
         raise UsageError(f"--domain must be base, shifted or wide (got {domain!r})")
     grid_rc = _size(grid, "--grid", 512) if grid else ((24, 32) if dataset is not None else (64, 64))
@@ -124,9 +130,9 @@ def simulate(
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
-                        json_out, placement)
+                        json_out, placement, spp)
     if world == "mixed":
-        raise UsageError("--world mixed is for --dataset; a single video is room or flatland")
+        raise UsageError("--world mixed is for --dataset; a single video is room, flatland or pt")
     acts = [a.strip() for a in activity.split(",") if a.strip()]
     for a in acts:
         if a not in ACTS + ("random",):
@@ -149,7 +155,7 @@ def simulate(
 
 def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, world, domain, dist, spd, level, iso_gain,
            read_noise, sensor_pixels, prnu, gamma, noise_scale, drift, flicker, mains, ae_steps, shake, nuisances,
-           preview, json_out, force, acts, suffix, **_):
+           preview, json_out, force, acts, suffix, spp, **_):
     import json
 
     from wallcli.cli.output import progress
@@ -174,7 +180,12 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
 
         cfg = SceneConfig(people=people, activities=None if acts == ["random"] else acts, duration=duration, fps=fps,
                           width=w, height=h, grid=grid_rc, domain=domain, distance=dist, speed=spd, codec=codec, crf=crf,
-                          noise_scale=noise_scale, nuisance_p=nuisances, camera_overrides=overrides)
+                          noise_scale=noise_scale, nuisance_p=nuisances, camera_overrides=overrides,
+                          world="pt" if world == "pt" else "room", spp=spp)
+        if world == "pt":
+            from wallcli.sim.pathtrace import require
+
+            require()  # a missing extra is one clear error before any output is opened
         scene = sample_scene(seed, cfg)
     n = len(scene.times)
     pix_fmt = video_pix_fmt(scene.camera) if suffix != ".y4m" else None
@@ -211,7 +222,7 @@ def _finish(output, tmp_video, sidecar, truth, preview, json_out, force) -> None
             "persons": [{k: v for k, v in p.items() if k != "positions"} for p in truth.get("persons", [])]})
 
 
-def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out, placement) -> None:
+def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out, placement, spp=256) -> None:
     import os
     import time
 
@@ -223,11 +234,17 @@ def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid
         raise WallcliError(f"dataset output must be a folder: {output} is a file")
     if not output.parent.is_dir() and str(output.parent):
         raise WallcliError(f"output folder does not exist: {output.parent}")
+    if world == "pt":
+        from wallcli.sim.pathtrace import require
+
+        require()  # checked here, once, not in every worker
+        jobs = jobs or 1  # Mitsuba already renders each frame on every core (or on the GPU)
     jobs = jobs or os.cpu_count() or 1
     t0 = time.perf_counter()
     with progress(f"dataset ({task})", n) as advance:
         manifest = build_dataset(output, n, task, seed=seed, jobs=jobs, domain=domain, world=world,
                                  windows_per_scene=wps, shard_scenes=shard_scenes, grid=grid_rc, force=force, placement=placement,
+                                 spp=spp,
                                  advance=advance, log=lambda m: console_err.print(m))
     dt = time.perf_counter() - t0
     console_err.print(f"wrote {n} windows in {len(manifest['shards'])} shard(s) to {output} in {dt:.1f} s")

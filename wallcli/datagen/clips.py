@@ -129,7 +129,7 @@ def _fit_snr_db(x: np.ndarray, signals: list[np.ndarray]) -> tuple[np.ndarray, f
 
 def render_windows(seed: int, index: int, task: str, *, domain: str = "base", world: str = "room",
                    windows: int = 3, grid: tuple[int, int] = (24, 32), tmpdir: str | None = None,
-                   camera_overrides: dict | None = None, placement: str = "visible") -> dict:
+                   camera_overrides: dict | None = None, placement: str = "visible", spp: int = 256) -> dict:
     """All windows of scene ``index``: arrays (k, BINS, WINDOW, 3) + labels + the scene's parameters."""
     from wallcli.io.video import open_video
     from wallcli.io.writer import VideoWriter
@@ -150,7 +150,8 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         acts = ["walking"] * people
     else:
         cfg = SceneConfig(people=people, activities=acts or None, duration=duration, grid=grid, domain=domain,
-                          camera_overrides=dict(camera_overrides or {}), **PLACEMENTS[placement])
+                          camera_overrides=dict(camera_overrides or {}), world="pt" if world == "pt" else "room", spp=spp,
+                          **PLACEMENTS[placement])
         scene = sample_scene(seed, cfg, index=index)
         scene.clean_profiles = []
     cam = scene.camera

@@ -25,10 +25,12 @@ CLASSES = {"count": [0, 1, 2], "activity": list(ACTIVITIES)}
 ARRAYS = ("horizontal", "vertical", "label", "people", "activity", "snr_db", "snr_db_weakest", "h_offset", "v_offset")
 
 
-def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible") -> dict:
+def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible", spp=256) -> dict:
     rec = {"task": task, "seed": int(seed), "windows": int(n), "domain": domain, "world": world,
             "windows_per_scene": int(windows_per_scene), "shard_scenes": int(shard_scenes), "grid": list(grid),
             "placement": placement, "generator": "wallcli.datagen v1"}
+    if world == "pt":  # path traced: its sample count is part of the data (other worlds' recipes unchanged)
+        rec["spp"] = int(spp)
     if task == "count":  # the movers' activity mix (a dataset made with another mix is another dataset)
         rec["count_activities"] = dict(zip(*COUNT_ACTS))
     return rec
@@ -59,9 +61,9 @@ def _shard_ok(path: Path, keep: int) -> bool:
 
 
 def _work(args):
-    seed, index, task, domain, world, wps, grid, cam, placement = args
+    seed, index, task, domain, world, wps, grid, cam, placement, spp = args
     out = render_windows(seed, index, task, domain=domain, world=world, windows=wps, grid=tuple(grid),
-                         camera_overrides=cam, placement=placement)
+                         camera_overrides=cam, placement=placement, spp=spp)
     return index, out
 
 
@@ -85,7 +87,7 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
                   domain: str = "base", world: str = "room", windows_per_scene: int = 4,
                   shard_scenes: int = 32, grid=(24, 32), force: bool = False,
                   advance: Callable[[int], None] | None = None, log: Callable[[str], None] | None = None,
-                  camera_overrides: dict | None = None, placement: str = "visible") -> dict:
+                  camera_overrides: dict | None = None, placement: str = "visible", spp: int = 256) -> dict:
     """Write (or finish) the dataset in ``out_dir``; returns the manifest.
 
     ``camera_overrides`` fixes camera parameters for every scene (tests, special sets); it is
@@ -97,7 +99,7 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    rec = recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement)
+    rec = recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement, spp)
     if camera_overrides:
         rec["camera_overrides"] = dict(camera_overrides)
     manifest_path = out / "dataset.json"
@@ -129,7 +131,7 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
         log(f"resuming: {len(plan) - len(todo)} of {len(plan)} shards already done")
     pending = {k: {"idx": idx, "keep": keep, "got": {}} for k, idx, keep in todo}
     owner = {i: k for k, idx, _ in todo for i in idx}
-    tasks = [(seed, i, task, domain, world, windows_per_scene, list(grid), camera_overrides, placement)
+    tasks = [(seed, i, task, domain, world, windows_per_scene, list(grid), camera_overrides, placement, spp)
              for k, idx, _ in todo for i in idx]
     if tasks:
         ctx = mp.get_context("fork") if hasattr(os, "fork") else mp.get_context()

@@ -78,8 +78,9 @@ def _unit(*components):
     return np.stack(components, -1)
 
 
-def sphere_centers(person: Person, pose: dict) -> np.ndarray:
-    """Sphere centres (T, 20, 3) for pose tracks (arrays of length T, see motion.py)."""
+def _skeleton(person: Person, pose: dict) -> dict:
+    """Joints and the body's frame per frame (arrays (T, 3)); sides are 'l' (the person's left,
+    the first of each pose pair) and 'r'. Limb directions (unit, (T, 3)) ride along as d_*."""
     s, g = person.s, person.girth
     x, y, psi = pose["x"], pose["y"], pose["heading"]
     T = len(x)
@@ -92,31 +93,24 @@ def sphere_centers(person: Person, pose: dict) -> np.ndarray:
     hip_z = 0.92 * s - crouch * 0.5 * s + pose.get("bob", 0.0) * s
     root = _unit(x, y, np.zeros(T))
     lift = pose["lift"][:, None] * up
-    out = np.empty((T, N_SPHERES, 3))
 
     lean = pose["lean"]
     trunk = np.cos(lean)[:, None] * up + np.sin(lean)[:, None] * f
     pelvis = root + hip_z[:, None] * up + lift
-    out[:, 1] = pelvis + 0.03 * s * trunk
-    out[:, 2] = pelvis + 0.22 * s * trunk
-    out[:, 3] = pelvis + 0.40 * s * trunk
-    out[:, 0] = pelvis + 0.72 * s * trunk
-    shoulder_c = pelvis + 0.53 * s * trunk
-
+    j = {"forward": f, "left": lat, "trunk": trunk, "pelvis": pelvis,
+         "head": pelvis + 0.72 * s * trunk, "neck": pelvis + 0.53 * s * trunk}
     for k, side in enumerate((1.0, -1.0)):
+        n = "lr"[k]
         # arms: sagittal swing (forward +) and abduction (sideways up), elbow flex
         sw, ab, el = pose["arm_swing"][:, k], pose["arm_abduct"][:, k], pose["elbow"][:, k]
-        sh = shoulder_c + (side * 0.19 * s * g) * lat
+        sh = j["neck"] + (side * 0.19 * s * g) * lat
         d1 = (-np.cos(ab) * np.cos(sw))[:, None] * up + (np.cos(ab) * np.sin(sw))[:, None] * f + (side * np.sin(ab))[:, None] * lat
         wave = pose["wave"][:, k]  # forearm rotation in the arm's frontal plane
         a2 = ab + el * 0.5 + wave
         d2 = (-np.cos(a2) * np.cos(sw + el * 0.5))[:, None] * up + (np.cos(a2) * np.sin(sw + el * 0.5))[:, None] * f + (side * np.sin(a2))[:, None] * lat
         elbow = sh + 0.30 * s * d1
-        base = 4 + 4 * k
-        out[:, base] = sh + 0.30 * s * 0.25 * d1
-        out[:, base + 1] = sh + 0.30 * s * 0.72 * d1
-        out[:, base + 2] = elbow + 0.28 * s * 0.3 * d2
-        out[:, base + 3] = elbow + 0.28 * s * 0.8 * d2
+        j.update({f"shoulder_{n}": sh, f"elbow_{n}": elbow, f"wrist_{n}": elbow + 0.28 * s * d2,
+                  f"d_upperarm_{n}": d1, f"d_forearm_{n}": d2})
 
         # legs: hip angle (forward +) and knee flex; in a squat the knee is solved so feet stay down
         hip = pelvis + (side * 0.09 * s * g) * lat
@@ -127,6 +121,37 @@ def sphere_centers(person: Person, pose: dict) -> np.ndarray:
         d_t = np.sin(th)[:, None] * f - np.cos(th)[:, None] * up
         d_s = np.sin(th - kn)[:, None] * f - np.cos(th - kn)[:, None] * up
         knee = hip + thigh * d_t
+        j.update({f"hip_{n}": hip, f"knee_{n}": knee, f"ankle_{n}": knee + shin * d_s,
+                  f"d_thigh_{n}": d_t, f"d_shin_{n}": d_s})
+    return j
+
+
+def joints(person: Person, pose: dict) -> dict:
+    """Joint positions (T, 3) for pose tracks: pelvis, neck (between the shoulders), head (its
+    centre), shoulder/elbow/wrist/hip/knee/ankle _l and _r; plus the unit vectors forward, left
+    and trunk (pelvis to neck). The path tracer builds its box people from these."""
+    return {k: v for k, v in _skeleton(person, pose).items() if not k.startswith("d_")}
+
+
+def sphere_centers(person: Person, pose: dict) -> np.ndarray:
+    """Sphere centres (T, 20, 3) for pose tracks (arrays of length T, see motion.py)."""
+    s = person.s
+    j = _skeleton(person, pose)
+    pelvis, trunk = j["pelvis"], j["trunk"]
+    out = np.empty((len(pelvis), N_SPHERES, 3))
+    out[:, 1] = pelvis + 0.03 * s * trunk
+    out[:, 2] = pelvis + 0.22 * s * trunk
+    out[:, 3] = pelvis + 0.40 * s * trunk
+    out[:, 0] = j["head"]
+    thigh = shin = 0.45 * s
+    for k, n in enumerate("lr"):
+        sh, d1, d2, elbow = j[f"shoulder_{n}"], j[f"d_upperarm_{n}"], j[f"d_forearm_{n}"], j[f"elbow_{n}"]
+        base = 4 + 4 * k
+        out[:, base] = sh + 0.30 * s * 0.25 * d1
+        out[:, base + 1] = sh + 0.30 * s * 0.72 * d1
+        out[:, base + 2] = elbow + 0.28 * s * 0.3 * d2
+        out[:, base + 3] = elbow + 0.28 * s * 0.8 * d2
+        hip, d_t, d_s, knee = j[f"hip_{n}"], j[f"d_thigh_{n}"], j[f"d_shin_{n}"], j[f"knee_{n}"]
         base = 12 + 4 * k
         out[:, base] = hip + thigh * 0.3 * d_t
         out[:, base + 1] = hip + thigh * 0.78 * d_t

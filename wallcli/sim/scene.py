@@ -40,6 +40,10 @@ class SceneConfig:
     noise_scale: float = 1.0
     nuisance_p: float = 0.35
     camera_overrides: dict = field(default_factory=dict)
+    # light transport: 'room' = the analytic renderer (room.py, people of spheres); 'pt' = Mitsuba 3
+    # path tracing of the same scene with people of boxes (pathtrace.py; needs wallcli[pt])
+    world: str = "room"
+    spp: int = 256  # pt: samples per wall point and frame
 
 
 @dataclass
@@ -85,6 +89,9 @@ class Scene:
 
     def frames(self) -> Iterator[np.ndarray]:
         """uint8 RGB frames (H, W, 3)."""
+        if self.config.world == "pt":
+            yield from self._pt_frames()
+            return
         E0 = self.static_irradiance()
         wall_albedo = np.clip(self.room.albedo[2].mean(axis=(0, 1)), 0.05, 0.95)
         cam = Camera(self.camera, E0, wall_albedo, len(self.times), self.rng)
@@ -120,6 +127,29 @@ class Scene:
                 self.clean_profiles.append(entry)
             yield cam.render(dE, i, static_E=E0)
 
+    def _pt_frames(self) -> Iterator[np.ndarray]:
+        """frames() by path tracing: the empty room once (same sampler seed as every frame, so
+        the static room cancels exactly in the differences), then each frame's change from it."""
+        from wallcli.sim.pathtrace import PathTracer
+
+        tracer = PathTracer(self.room, self.points, self.people, self.poses, spp=self.config.spp,
+                            seed=self.seed % 2**31)
+        E0 = tracer.irradiance(None)
+        wall_albedo = np.clip(self.room.albedo[2].mean(axis=(0, 1)), 0.05, 0.95)
+        cam = Camera(self.camera, E0, wall_albedo, len(self.times), self.rng)
+        E0_safe = np.maximum(E0, 1e-12)
+        for i in range(len(self.times)):
+            dE = tracer.irradiance(i) - E0 if self.people else np.zeros_like(E0)
+            if self.clean_profiles is not None:
+                rel = dE / E0_safe
+                entry = (rel.mean(axis=0), rel.mean(axis=1))
+                if len(self.people) > 1:
+                    # each person alone: one more render per person (see the analytic path above)
+                    entry = (*entry, [((tracer.irradiance(i, who=[j]) - E0) / E0_safe).mean(axis=0)
+                                      for j in range(len(self.people))])
+                self.clean_profiles.append(entry)
+            yield cam.render(dE, i, static_E=E0)
+
     def truth(self, frames: int | None = None) -> dict:
         """The JSON sidecar: CONTRACT fields plus everything needed to reproduce or study the clip."""
         n = len(self.times) if frames is None else frames
@@ -136,6 +166,7 @@ class Scene:
             "people": len(self.people), "activity": self.label_activity, "activities": list(self.activities),
             "fps": self.camera.fps, "frames": n, "seed": self.seed, "width": self.camera.width,
             "height": self.camera.height, "domain": self.config.domain,
+            **({"world": "pt", "spp": int(self.config.spp)} if self.config.world == "pt" else {}),
             "room": {"size_m": [round(W, 3), round(D, 3), round(H, 3)], "lamps": len(self.room.lamp_radius),
                      "lamp_positions": np.round(self.room.lamp_pos, 3).tolist(), "windows": len(self.room.windows)},
             "wall_region_m": [round(v, 3) for v in self.region],
