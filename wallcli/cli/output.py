@@ -72,7 +72,12 @@ def warn(message: str) -> None:
 def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
     from rich.table import Table
 
-    table = Table(title=printable(title), title_justify="left")
+    from rich.text import Text
+
+    # the title is its own unwrapped line: scripts grep it ("count = 1") and a long path must
+    # not split it across lines, as a table title wrapped to the table's width would
+    console_out.print(Text(printable(title)), soft_wrap=True)
+    table = Table()
     for i, col in enumerate(columns):
         table.add_column(printable(col), justify="left" if i == 0 else "right")
     for row in rows:
