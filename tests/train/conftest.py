@@ -59,3 +59,18 @@ def make_dataset(tmp_path):
              visibility: bool = False) -> Path:
         return write_dataset(tmp_path / name, task, n, seed=seed, shards=shards, visibility=visibility)
     return make
+
+
+@pytest.fixture
+def cli_code():
+    """Run ``wallcli`` in-process and return its exit code only, leaving captured output to the
+    test (the top-level ``run_cli`` fixture reads it away)."""
+    from wallcli.cli.app import main
+
+    def run(args):
+        try:
+            main([str(a) for a in args])
+        except SystemExit as exc:
+            return exc.code or 0
+        return 0
+    return run

@@ -6,18 +6,10 @@ import pytest
 torch = pytest.importorskip("torch")
 onnx = pytest.importorskip("onnx")
 
-from wallcli.cli.app import main  # noqa: E402
 from wallcli.infer.card import read_card, sha256_file  # noqa: E402
 from wallcli.infer.model import Model  # noqa: E402
 from wallcli.train.export import check_parity, export_model  # noqa: E402
 from wallcli.train.nets import build  # noqa: E402
-
-def run_cli(args):
-    try:
-        main(args)
-    except SystemExit as e:
-        return e.code or 0
-    return 0
 
 
 FIELDS = dict(name="t", version="0.0.1", training_data={"recipe": {}}, training={"seed": 0}, validation=None)
@@ -59,14 +51,14 @@ def test_parity_check_detects_a_different_model(tmp_path):
         check_parity(build("count").eval(), ["horizontal"], out)
 
 
-def test_train_command_end_to_end(make_dataset, tmp_path, capsys):
+def test_train_command_end_to_end(make_dataset, tmp_path, capsys, cli_code):
     data = make_dataset("count", 20)
     val = make_dataset("count", 6, seed=9, shards=1, name="val", visibility=True)
     out = tmp_path / "models" / "count.onnx"
     out.parent.mkdir()
     args = ["train", "count", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
             "--batch-size", "8", "--threads", "2", "--model-version", "0.1.0"]
-    assert run_cli(args) == 0
+    assert cli_code(args) == 0
     card = read_card(out)
     assert card["task"] == "count" and card["classes"] == [0, 1, 2] and card["version"] == "0.1.0"
     assert card["sha256"] == sha256_file(out)
@@ -87,38 +79,38 @@ def test_train_command_end_to_end(make_dataset, tmp_path, capsys):
     assert out.with_suffix(".ckpt.pt").is_file()
     assert capsys.readouterr().out == ""  # nothing but data on stdout
     # an existing model is never overwritten without --force, and the check comes before training
-    assert run_cli(args) == 1
+    assert cli_code(args) == 1
     assert "exists" in capsys.readouterr().err
 
 
-def test_train_on_two_folders(make_dataset, tmp_path):
+def test_train_on_two_folders(make_dataset, tmp_path, cli_code):
     a = make_dataset("count", 12)
     b = make_dataset("count", 8, seed=5, shards=1, name="more")
     out = tmp_path / "count.onnx"
     args = ["train", "count", "--data", str(a), "--data", str(b), "--val-fraction", "0.25", "--out", str(out),
             "--epochs", "1", "--batch-size", "4", "--threads", "1", "--ema", "0", "--superpose", "0.5"]
-    assert run_cli(args) == 0
+    assert cli_code(args) == 0
     card = read_card(out)
     assert card["training_data"]["windows"] == 20 and len(card["training_data"]["recipe"]) == 2
     assert card["training_data"]["dataset"] == [str(a), str(b)]
     assert card["training"]["augmentation"][0].startswith("superposition") and "--superpose 0.5" in card["training"]["command"]
 
 
-def test_superpose_is_refused_for_activity(make_dataset, tmp_path, capsys):
+def test_superpose_is_refused_for_activity(make_dataset, tmp_path, capsys, cli_code):
     data = make_dataset("activity", 8)
     args = ["train", "activity", "--data", str(data), "--out", str(tmp_path / "a.onnx"), "--superpose", "0.3"]
-    assert run_cli(args) == 2
+    assert cli_code(args) == 2
     assert "count only" in capsys.readouterr().err
 
 
-def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path):
+def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path, cli_code):
     monkeypatch.setitem(__import__("sys").modules, "torch", None)  # import torch -> ImportError
-    assert run_cli(["train", "count", "--data", str(tmp_path), "--out", str(tmp_path / "m.onnx")]) == 1
+    assert cli_code(["train", "count", "--data", str(tmp_path), "--out", str(tmp_path / "m.onnx")]) == 1
     err = capsys.readouterr().err
     assert err.startswith("Error:") and "pip install torch==2.13.0 && pip install 'wallcli[train]'" in err
 
 
-def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_dataset, tmp_path, capsys):
+def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_dataset, tmp_path, capsys, cli_code):
     pytest.importorskip("onnx")
     import onnx
 
@@ -127,7 +119,7 @@ def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_datas
     out = tmp_path / "act.onnx"
     args = ["train", "activity", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
             "--batch-size", "8", "--threads", "2", "--quantize", "int8"]
-    assert run_cli(args) == 0
+    assert cli_code(args) == 0
     card = read_card(out)
     assert card["sha256"] == sha256_file(out) and card["onnx"]["precision"] == "int8"
     # the closing line reports the shipped (int8) graph's accuracy, the one in the card
@@ -153,7 +145,7 @@ def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_datas
     assert p.shape == (2, 5) and np.allclose(p.sum(1), 1, atol=1e-5)
 
 
-def test_preprocessing_v2_is_trained_recorded_and_followed_at_inference(make_dataset, tmp_path, capsys):
+def test_preprocessing_v2_is_trained_recorded_and_followed_at_inference(make_dataset, tmp_path, capsys, cli_code):
     from wallcli.infer.model import Model
     from wallcli.signal.window import NORMALIZATION_V2, normalize_window
 
@@ -162,7 +154,7 @@ def test_preprocessing_v2_is_trained_recorded_and_followed_at_inference(make_dat
     out = tmp_path / "count.onnx"
     args = ["train", "count", "--data", str(data), "--val", str(val), "--out", str(out), "--epochs", "1",
             "--batch-size", "4", "--threads", "1", "--preprocessing", "v2"]
-    assert run_cli(args) == 0
+    assert cli_code(args) == 0
     card = read_card(out)
     assert card["preprocessing"] == NORMALIZATION_V2 and "asinh" in card["normalisation"]
     assert "--preprocessing v2" in card["training"]["command"]
@@ -174,6 +166,6 @@ def test_preprocessing_v2_is_trained_recorded_and_followed_at_inference(make_dat
     raw = np.concatenate([np.load(f)["horizontal"] for f in sorted(val.glob("shard-*.npz"))])
     assert np.mean(m.predict({"horizontal": m.normalize(raw)}).argmax(1) == labels) == card["validation"]["accuracy"]
     # a v1 checkpoint is not resumed into a v2 run (the inputs differ), and unknown versions are refused
-    assert run_cli([*args[:-2], "--preprocessing", "v1", "--force"]) == 1
+    assert cli_code([*args[:-2], "--preprocessing", "v1", "--force"]) == 1
     assert "different run" in capsys.readouterr().err
-    assert run_cli([*args[:-2], "--preprocessing", "v9", "--force"]) == 2
+    assert cli_code([*args[:-2], "--preprocessing", "v9", "--force"]) == 2

@@ -7,7 +7,6 @@ import pytest
 torch = pytest.importorskip("torch")
 pytest.importorskip("onnx")
 
-from wallcli.cli.app import main  # noqa: E402
 from wallcli.errors import WallcliError  # noqa: E402
 from wallcli.infer.card import read_card, sha256_file  # noqa: E402
 from wallcli.train.export import export_model  # noqa: E402
@@ -15,14 +14,6 @@ from wallcli.train.init import init_from_onnx  # noqa: E402
 from wallcli.train.nets import build  # noqa: E402
 
 FIELDS = dict(name="t", version="0.0.1", training_data={"recipe": {}}, training={"seed": 0}, validation=None)
-
-
-def _cli(args):
-    try:
-        main([str(a) for a in args])
-    except SystemExit as e:
-        return e.code or 0
-    return 0
 
 
 def _trained(task, seed=0):
@@ -66,15 +57,15 @@ def test_init_rejects_a_model_of_another_task(tmp_path):
         init_from_onnx(build("activity"), out, [torch.randn(2, 3, 64, 256)] * 2)
 
 
-def test_train_init_fine_tunes_and_records_the_base_model(make_dataset, tmp_path, capsys):
+def test_train_init_fine_tunes_and_records_the_base_model(make_dataset, tmp_path, capsys, cli_code):
     data = make_dataset("count", 16)
     val = make_dataset("count", 6, seed=9, shards=1, name="val", visibility=True)
     base = tmp_path / "base.onnx"
     args = ["train", "count", "--data", data, "--val", val, "--epochs", "1", "--batch-size", "8", "--threads", "1",
             "--quantize", "int8"]
-    assert _cli([*args, "--out", base]) == 0
+    assert cli_code([*args, "--out", base]) == 0
     tuned = tmp_path / "tuned.onnx"
-    assert _cli([*args, "--out", tuned, "--init", base, "--lr", "1e-4", "--anneal", "1"]) == 0
+    assert cli_code([*args, "--out", tuned, "--init", base, "--lr", "1e-4", "--anneal", "1"]) == 0
     card = read_card(tuned)
     assert card["training"]["init"]["sha256"] == sha256_file(base)
     assert card["training"]["lr"] == 1e-4 and "--init" in card["training"]["command"]
@@ -83,9 +74,9 @@ def test_train_init_fine_tunes_and_records_the_base_model(make_dataset, tmp_path
     # an activity model cannot start a count run
     act = make_dataset("activity", 8, name="act")
     a = tmp_path / "a.onnx"
-    assert _cli(["train", "activity", "--data", act, "--out", a, "--epochs", "1", "--batch-size", "4",
+    assert cli_code(["train", "activity", "--data", act, "--out", a, "--epochs", "1", "--batch-size", "4",
                  "--threads", "1", "--val-fraction", "0.25"]) == 0
-    assert _cli([*args, "--out", tmp_path / "x.onnx", "--init", a]) == 2
+    assert cli_code([*args, "--out", tmp_path / "x.onnx", "--init", a]) == 2
     assert "activity" in capsys.readouterr().err
 
 

@@ -8,17 +8,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from wallcli.cli.app import main  # noqa: E402
 from wallcli.infer.card import read_card  # noqa: E402
 from wallcli.train.data import ShardDataset  # noqa: E402
-
-
-def run_cli(args):
-    try:
-        main([str(a) for a in args])
-    except SystemExit as exc:
-        return exc.code or 0
-    return 0
 
 
 def _as_wide(root):
@@ -51,11 +42,11 @@ def test_a_wide_count_dataset_serves_the_activity_net(make_dataset):
         ShardDataset(make, "activity")
 
 
-def test_lite_nets_train_balanced_and_calibrated(make_dataset, tmp_path):
+def test_lite_nets_train_balanced_and_calibrated(make_dataset, tmp_path, cli_code):
     data = _as_wide(make_dataset("count", 24))
     val = _as_wide(make_dataset("count", 96, seed=9, shards=1, name="val", visibility=True))
     out = tmp_path / "count.onnx"
-    assert run_cli(["train", "count", "--data", data, "--val", val, "--out", out, "--epochs", "2", "--batch-size", "4",
+    assert cli_code(["train", "count", "--data", data, "--val", val, "--out", out, "--epochs", "2", "--batch-size", "4",
                     "--threads", "1", "--arch", "lite", "--balance", "--calibrate", val,
                     "--confidence-level", "0.9"]) == 0
     card = read_card(out)
@@ -68,7 +59,7 @@ def test_lite_nets_train_balanced_and_calibrated(make_dataset, tmp_path):
     # the thresholds are met on the windows they were fitted on, wherever something is decided
     if conf["calibrated_on"]["coverage"] > 0:
         assert conf["calibrated_on"]["accuracy_decided"] >= 0.9
-    assert run_cli(["train", "activity", "--data", data, "--out", tmp_path / "act.onnx", "--epochs", "1",
+    assert cli_code(["train", "activity", "--data", data, "--out", tmp_path / "act.onnx", "--epochs", "1",
                     "--batch-size", "4", "--threads", "1", "--arch", "lite", "--val-fraction", "0.25"]) == 0
     assert read_card(tmp_path / "act.onnx")["classes"][0] == "none"
-    assert run_cli(["train", "count", "--data", data, "--out", tmp_path / "x.onnx", "--arch", "huge"]) == 2
+    assert cli_code(["train", "count", "--data", data, "--out", tmp_path / "x.onnx", "--arch", "huge"]) == 2
