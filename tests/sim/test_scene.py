@@ -123,3 +123,33 @@ def test_wide_waving_and_jumping_add_whole_arm_motion():
         spans[domain] = (swings, overhead)
     assert spans["base"] == (0, 0)
     assert spans["wide"][0] >= 10 and spans["wide"][1] >= 10
+
+
+def _periodicity(x: np.ndarray, fps: float = 30.0) -> float:
+    """Share of a track's variance at its strongest frequency and two neighbours (1 = a pure tone)."""
+    x = x - x.mean()
+    p = np.abs(np.fft.rfft(x)) ** 2
+    k = int(np.argmax(p[1:])) + 1
+    return float(p[max(1, k - 1):k + 2].sum() / max(p[1:].sum(), 1e-12))
+
+
+def test_wide_waves_without_pause_and_jumps_in_rhythm():
+    """The 'wide' domain also waves for the whole clip and jumps in a steady rhythm (the renderer
+    of the transfer set makes such periodic motion; bouts with pauses were all our simulator drew):
+    some of its wavers keep the arm up all the time, and some jumpers' height tracks are periodic,
+    which never happens in the base domain."""
+    t = np.arange(0, 12, 1 / 30)
+    found = {}
+    for domain in ("base", "wide"):
+        steady_arm = periodic_jump = 0
+        for seed in range(40):
+            rng = np.random.default_rng(seed)
+            wave = motion.make_motion(rng, "waving", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
+            jump = motion.make_motion(rng, "jumping", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
+            # arm never lowered back to the side after the first second
+            steady_arm += bool(np.all(wave["arm_abduct"][30:].max(axis=1) > 0.3))
+            periodic_jump += _periodicity(jump["lift"]) > 0.55
+        found[domain] = (steady_arm, periodic_jump)
+    # base: a 2-7 s bout can span a clip by chance (1 of 40 seeds), a jump track is never periodic
+    assert found["base"][0] <= 2 and found["wide"][0] >= 12
+    assert found["base"][1] <= 1 and found["wide"][1] >= 10

@@ -61,7 +61,9 @@ def simulate(
     spp: int = number_option(256, "--spp", lo=1, hi=65536, integer=True, help="--world pt: path-traced samples per wall point "
                              "and frame (Monte Carlo noise in the people's signal falls as 1/sqrt(spp))."),
     domain: str = typer.Option("base", "--domain", help="base: training ranges; shifted: moved ranges of room size, lights, "
-                               "clothing, body size, camera (an honest held-out validation set)."),
+                               "clothing, body size, camera (an honest held-out validation set); wide: both and more (windows, ceiling "
+                               "panels, small frames, lighting nuisances in half the clips, periodic waving and jumping half the "
+                               "time); steady: wide with steady light in most rooms (nuisances in a sixth)."),
     distance: str = typer.Option("1,5", "--distance", help="MIN,MAX distance of people from the wall (m)."),
     speed: str = typer.Option("0.5,1.8", "--speed", help="MIN,MAX walking speed (m/s)."),
     level: Optional[float] = number_option(None, "--level", lo=5, hi=250, help="Mean wall brightness in 8-bit codes (default: random from the seed)."),
@@ -118,8 +120,8 @@ def simulate(
 
     if world not in ("room", "flatland", "mixed", "pt"):
         raise UsageError(f"--world must be room, flatland, pt or mixed (got {world!r})")
-    if domain not in ("base", "shifted", "wide"):
-        raise UsageError(f"--domain must be base, shifted or wide (got {domain!r})")
+    if domain not in ("base", "shifted", "wide", "steady"):
+        raise UsageError(f"--domain must be base, shifted, wide or steady (got {domain!r})")
     grid_rc = _size(grid, "--grid", 512) if grid else ((24, 32) if dataset is not None else (64, 64))
     # checked in both modes, so that a mistyped value is never silently ignored
     if task not in ("count", "activity"):

@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from wallcli.sim import WIDE_DOMAINS
+
 from wallcli.sim.camera import interp_matrix, video_pix_fmt
 from wallcli.sim.motion import ACTIVITIES
 from wallcli.sim.scene import SceneConfig, sample_scene
@@ -40,7 +42,7 @@ def scene_plan(rng: np.random.Generator, task: str, domain: str = "base") -> tup
     The 'wide' domain's count scenes serve both tasks: movers' activities are balanced, and a
     third of the empty rooms hold someone standing still (label 0: count counts movers), whose
     sway can be visible."""
-    if task == "count" and domain == "wide":
+    if task == "count" and domain in WIDE_DOMAINS:
         n = int(rng.integers(0, 3))
         if n == 0:
             return (1, ["none"], 0) if rng.random() < 0.35 else (0, [], 0)

@@ -28,7 +28,9 @@ ARRAYS = ("horizontal", "vertical", "label", "people", "activity", "snr_db", "sn
 def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible", spp=256) -> dict:
     rec = {"task": task, "seed": int(seed), "windows": int(n), "domain": domain, "world": world,
             "windows_per_scene": int(windows_per_scene), "shard_scenes": int(shard_scenes), "grid": list(grid),
-            "placement": placement, "generator": "wallcli.datagen v1"}
+            "placement": placement, "generator": "wallcli.datagen v1",
+            # bodies shadow the room's other surfaces (sim/shadows.py): data made before is other data
+            "physics": "room-shadows"}
     if world == "pt":  # path traced: its sample count is part of the data (other worlds' recipes unchanged)
         rec["spp"] = int(spp)
     if task == "count":  # the movers' activity mix (a dataset made with another mix is another dataset)

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wallcli.sim import WIDE_DOMAINS
+
 N_SPHERES = 20
 # sphere -> body part: 0 head, 1 torso (top clothing), 2 arms (top / skin), 3 legs (bottom)
 PART = np.array([0, 1, 1, 1] + [2] * 8 + [3] * 8)
@@ -66,7 +68,7 @@ def _colour(rng, lo: float, hi: float) -> np.ndarray:
 
 
 def sample_person(rng: np.random.Generator, domain: str = "base") -> Person:
-    shifted, wide = domain == "shifted", domain == "wide"
+    shifted, wide = domain == "shifted", domain in WIDE_DOMAINS
     height = rng.uniform(1.25, 2.0) if (shifted or wide) else rng.uniform(1.5, 1.95)
     girth = rng.uniform(0.8, 1.35) if (shifted or wide) else rng.uniform(0.85, 1.2)
     lo, hi = (0.02, 0.5) if shifted else ((0.02, 0.85) if wide else (0.03, 0.85))

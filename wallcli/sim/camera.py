@@ -19,6 +19,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from wallcli.sim import WIDE_DOMAINS
+
 NOISE_FLOOR = 0.35
 CLIP_GUARD = 235.0  # output code the brightest 0.5 % of the static wall may reach (headroom for AE steps)
 
@@ -53,8 +55,8 @@ class CameraParams:
 
 def sample_camera(rng: np.random.Generator, domain: str = "base", *, nuisance_p: float = 0.35) -> CameraParams:
     """Random camera: from very clean (large ROI, low gain) to very noisy (small ROI, high ISO)."""
-    if domain == "wide":
-        return _sample_wide_camera(rng)
+    if domain in WIDE_DOMAINS:
+        return _sample_wide_camera(rng, nuisance_p=0.5 if domain == "wide" else 1 / 6)
     shifted = domain == "shifted"
     w = int(rng.choice([128, 144, 160, 176, 192]) if not shifted else rng.choice([96, 112, 208, 224]))
     h = int(2 * round(w * rng.uniform(0.56, 0.8) / 2))
@@ -89,7 +91,7 @@ def _nuisances(rng, p: CameraParams, *, drift: float, flicker: float, flicker_p:
     p.shake = rng.uniform(0.0, 0.3) * (rng.random() < 0.5)
 
 
-def _sample_wide_camera(rng) -> CameraParams:
+def _sample_wide_camera(rng, nuisance_p: float = 0.5) -> CameraParams:
     """The 'wide' domain's camera: the union of the base and shifted ranges, small frames too, and
     lighting nuisances (drift, aliased mains flicker of up to 1 %, exposure steps) in half the clips:
     real rooms change their whole light while nobody moves, and a model must not count that."""
@@ -109,7 +111,7 @@ def _sample_wide_camera(rng) -> CameraParams:
         # crf 0 is lossless H.264, which some recorders write
         p.codec, p.crf = "libx264", (0 if rng.random() < 0.2 else int(rng.integers(6, 26)))
     p.chroma = "420" if rng.random() < 0.6 else "444"
-    if rng.random() < 0.5:
+    if rng.random() < nuisance_p:
         _nuisances(rng, p, drift=0.015, flicker=0.01, flicker_p=0.6)
     return p
 

@@ -8,13 +8,16 @@ deep squat), bob (hip height offset / scale), lift (whole-body height offset, ju
 Activities (the classes): none (standing still: breathing-scale sway only), walking (waypoint
 paths at 0.5-1.8 m/s with smooth turns and stops), crouching (squat down/hold/up bouts),
 waving (one or both arms raised, forearm oscillating 1-3 Hz, in bouts; 'wide' also whole arms
-swinging from the shoulder), jumping (pre-crouch, ballistic flight of 5-40 cm, 'wide' up to 50 cm
-and arms overhead, landing, pauses).
+swinging from the shoulder, and half the time without pause), jumping (pre-crouch, ballistic
+flight of 5-40 cm, 'wide' up to 50 cm and arms overhead, landing, pauses; 'wide' half the time
+in a steady rhythm).
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from wallcli.sim import WIDE_DOMAINS
 
 ACTIVITIES = ["none", "walking", "crouching", "waving", "jumping"]
 G = 9.81
@@ -142,10 +145,15 @@ def waving(rng, t, spot, domain: str = "base"):
     both swinging from the shoulder between hip and overhead (signalling, cheering): the larger
     motion that people also make and that changes a wall's light many times more."""
     pose = standing(rng, t, spot)
-    both = rng.random() < (0.5 if domain == "wide" else 0.35)
+    both = rng.random() < (0.5 if domain in WIDE_DOMAINS else 0.35)
     side = int(rng.integers(0, 2))
     on = _smooth(_bouts(rng, t, (2.0, 7.0), (0.3, 2.0)), 0.5 / max(t[1] - t[0], 1e-3))
-    if domain == "wide" and rng.random() < 0.55:
+    if domain in WIDE_DOMAINS and rng.random() < 0.5:
+        # waving without pause for the whole clip (flagging someone down, a long cheer): then the
+        # wall's change is the wave itself, periodic with its harmonics, not the slow raising and
+        # lowering of the arm between bouts (research/features/README.md)
+        on = np.ones(len(t))
+    if domain in WIDE_DOMAINS and rng.random() < 0.55:
         freq = rng.uniform(0.6, 2.5)
         lo, hi = rng.uniform(0.15, 1.4), rng.uniform(2.2, 3.0)
         phase = rng.uniform(0, 2 * np.pi)
@@ -173,12 +181,17 @@ def jumping(rng, t, spot, domain: str = "base"):
     pose = standing(rng, t, spot)
     c, lift, arms = np.zeros(len(t)), np.zeros(len(t)), np.zeros(len(t))
     now = t[0] - rng.uniform(0, 2)
-    wide = domain == "wide"
+    wide = domain in WIDE_DOMAINS
     height_base = rng.uniform(0.06, 0.5 if wide else 0.4)
     overhead = wide and rng.random() < 0.5
+    # 'wide' also jumps in a steady rhythm half the time (skipping, jumping jacks): one pause and
+    # one height for the clip, so the wall's change is periodic, as a jumping person's often is
+    rhythm = rng.uniform(0.02, 0.3) if wide and rng.random() < 0.5 else None
     while now < t[-1]:
         prep, land = rng.uniform(0.2, 0.45), rng.uniform(0.15, 0.35)
         h = height_base * rng.uniform(0.7, 1.2)
+        if rhythm is not None:
+            prep, land, h = 0.3, 0.25, height_base
         fly = 2 * np.sqrt(2 * h / G)
         depth = rng.uniform(0.15, 0.45)
         m = (t >= now) & (t < now + prep)
@@ -191,6 +204,9 @@ def jumping(rng, t, spot, domain: str = "base"):
         arms[m] = 1.2 * np.sin(np.pi * tau / fly)
         m = (t >= now + prep + fly) & (t < now + prep + fly + land)
         c[m] = depth * 0.8 * np.sin(np.pi * (t[m] - now - prep - fly) / land)
+        if rhythm is not None:
+            now += prep + fly + land + rhythm
+            continue
         now += prep + fly + land + (rng.uniform(0.05, 0.6) if rng.random() < 0.6 else rng.uniform(0.6, 2.5))
     pose["crouch"], pose["lift"] = c, lift
     pose["lean"] = 0.5 * c

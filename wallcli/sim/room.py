@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wallcli.sim import WIDE_DOMAINS
+
 from wallcli.sim.geometry import disc_overlap, lambert_sphere_phase, polygon_form_factor
 
 NORMALS = np.array([[1, 0, 0], [-1, 0, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], float)
@@ -152,7 +154,7 @@ def _paint(rng, lo: float, hi: float, tint: float) -> np.ndarray:
 def sample_room(rng: np.random.Generator, domain: str = "base") -> Room:
     """A random furnished box room. ``domain='shifted'`` moves every range (held-out validation);
     ``domain='wide'`` spans both and lights rooms the ways rooms are lit (``_wide_lighting``)."""
-    if domain == "wide":
+    if domain in WIDE_DOMAINS:
         return _sample_room(rng, "wide", rng.uniform(3.0, 9.0), rng.uniform(4.5, 10.0), rng.uniform(2.4, 3.8))
     shifted = domain == "shifted"
     W = rng.uniform(5.5, 9.0) if shifted else rng.uniform(3.0, 7.0)
@@ -186,7 +188,7 @@ def _wide_lighting(rng) -> tuple[int, list[int]]:
 
 def _sample_room(rng, domain, W, D, H) -> Room:
     shifted = domain == "shifted"
-    wide = domain == "wide"
+    wide = domain in WIDE_DOMAINS
     size = np.array([W, D, H])
     albedo = np.empty((5, TEX, TEX, 3))
     wall_paint = _paint(rng, 0.25, 0.6, 0.25) if shifted else (_paint(rng, 0.25, 0.9, 0.25) if wide else _paint(rng, 0.4, 0.9, 0.15))

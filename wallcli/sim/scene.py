@@ -12,10 +12,11 @@ from typing import Iterator
 
 import numpy as np
 
-from wallcli.sim import bodies, motion
+from wallcli.sim import WIDE_DOMAINS, bodies, motion
 from wallcli.sim.camera import Camera, CameraParams, sample_camera
 from wallcli.sim.room import (Room, body_delta, body_radiance, index_interp, overlapping_pairs, sample_room,
                               static_irradiance)
+from wallcli.sim.shadows import shadow_delta
 
 ACTIVITIES = motion.ACTIVITIES
 
@@ -44,6 +45,9 @@ class SceneConfig:
     # path tracing of the same scene with people of boxes (pathtrace.py; needs wallcli[pt])
     world: str = "room"
     spp: int = 256  # pt: samples per wall point and frame
+    # room world: bodies also shadow the room's other surfaces (shadows.py), a whole-wall dimming the
+    # path tracer shows; False renders the direct term only, as the simulator did before
+    shadows: bool = True
 
 
 @dataclass
@@ -106,8 +110,7 @@ class Scene:
                 C = np.concatenate([c[i] for c, _, _ in tracks])
                 R = np.concatenate([r for _, r, _ in tracks])
                 A = np.concatenate([a for _, _, a in tracks])
-                pairs = overlapping_pairs(probes, C, R)
-                dE = body_delta(self.room, self.points, C, R, body_radiance(self.room, C, A, view), bbox, pairs)
+                dE = self._delta(C, R, A, probes, view, bbox)
             else:
                 dE = np.zeros_like(E0)
             if self.clean_profiles is not None:
@@ -119,13 +122,19 @@ class Scene:
                     # people is invisible must not pass for a window where both are seen
                     alone = []
                     for c, r, a in tracks:
-                        Ci = c[i]
-                        dEi = body_delta(self.room, self.points, Ci, r, body_radiance(self.room, Ci, a, view), bbox,
-                                         overlapping_pairs(probes, Ci, r))
+                        dEi = self._delta(c[i], r, a, probes, view, bbox)
                         alone.append((dEi / E0_safe).mean(axis=0))
                     entry = (*entry, alone)
                 self.clean_profiles.append(entry)
             yield cam.render(dE, i, static_E=E0)
+
+    def _delta(self, C, R, A, probes, view, bbox) -> np.ndarray:
+        """The wall's irradiance change (gy, gx, 3) from spheres C, R, A in one frame."""
+        dE = body_delta(self.room, self.points, C, R, body_radiance(self.room, C, A, view), bbox,
+                        overlapping_pairs(probes, C, R))
+        if self.config.shadows:
+            dE = dE + shadow_delta(self.room, self.points, C, R, A)
+        return dE
 
     def _pt_frames(self) -> Iterator[np.ndarray]:
         """frames() by path tracing: the empty room once (same sampler seed as every frame, so
@@ -178,7 +187,7 @@ class Scene:
 
 def _region(rng, size, domain):
     W, D, H = size
-    w = min(rng.uniform(0.6, 4.0) if domain in ("shifted", "wide") else rng.uniform(0.8, 3.0), W - 0.4)
+    w = min(rng.uniform(0.6, 4.0) if domain in ("shifted", *WIDE_DOMAINS) else rng.uniform(0.8, 3.0), W - 0.4)
     h = min(w * rng.uniform(0.55, 0.85), H - 0.3)
     lo = 0.2 + w / 2
     xc = rng.uniform(lo, max(lo, W - 0.2 - w / 2))  # equal bounds (a wall-wide region) may round to hi < lo

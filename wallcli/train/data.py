@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from wallcli.sim import WIDE_DOMAINS
+
 from wallcli.errors import WallcliError
 from wallcli.infer.card import TASK_CLASSES, TASK_INPUTS
 
@@ -67,7 +69,7 @@ class ShardDataset:
         if man.get("complete") is False:
             raise WallcliError(f"{root} is still being written (dataset.json says complete: false)",
                                hint="finish it by re-running the same dataset command")
-        wide = (man.get("recipe") or {}).get("domain") == "wide"
+        wide = (man.get("recipe") or {}).get("domain") in WIDE_DOMAINS
         if man.get("task") == "count" and task == "activity" and wide:
             return man
         if man.get("task") != task:
