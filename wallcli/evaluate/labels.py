@@ -6,12 +6,14 @@ is optional and every other column is ignored. A sidecar's ``people`` counts eve
 so a count's truth there is the number of its ``activities`` other than ``none`` (what
 tests/test_examples.py checks the shipped models against). Labels that cannot be read are a
 failure of the whole run (exit 1, naming the line); a clip that is missing is not: it becomes
-that clip's error row.
+that clip's error row. Two names for one file (``a.mp4``, ``./a.mp4``) are one clip listed
+twice: an error, as any duplicate is, since scoring it twice would weigh it double.
 """
 from __future__ import annotations
 
 import csv
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -62,18 +64,26 @@ def _from_csv(d: Path) -> list[Clip]:
                 raise WallcliError(f"{path} lacks the column(s) {', '.join(missing)} (needs {', '.join(REQUIRED)}; "
                                    f"has {', '.join(header) or 'none'})")
             reader.fieldnames = header
-            clips = [_csv_row(path, n, row) for n, row in enumerate(reader, start=2)
+            named = [(f"line {n}", _csv_row(path, n, row)) for n, row in enumerate(reader, start=2)
                      if any((v or "").strip() for v in row.values() if isinstance(v, str))]
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise WallcliError(f"cannot read {path}: {exc}") from None
-    if not clips:
+    if not named:
         raise WallcliError(f"{path} lists no clips")
-    seen: set[str] = set()
-    for c in clips:
-        if c.file in seen:
-            raise WallcliError(f"{path} lists {c.file} twice")
-        seen.add(c.file)
-    return clips
+    _no_duplicates(path, named)
+    return [c for _, c in named]
+
+
+def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
+    """Fail on two entries that name one file, however spelled (``a.mp4``, ``./a.mp4``, its full path)."""
+    seen: dict[str, tuple[str, Clip]] = {}
+    for where, c in named:
+        key = os.path.normcase(os.path.normpath(os.path.abspath(c.path)))
+        if key in seen:
+            first, other = seen[key]
+            raise WallcliError(f"{source} names one clip twice: {first} ({other.file!r}) and {where} ({c.file!r}); "
+                               "list each clip once")
+        seen[key] = (where, c)
 
 
 def _csv_row(path: Path, line: int, row: dict) -> Clip:
