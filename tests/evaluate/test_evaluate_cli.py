@@ -133,3 +133,17 @@ def test_one_decode_per_clip_gives_both_the_answer_and_the_snr(sims, single, mon
 def test_an_roi_outside_every_frame_fails_the_run(sims, run_cli):
     code, out, err = run_cli("evaluate", sims, "--task", "count", "--roi", "0,0,500,500", "--jobs", "1")
     assert code == 1 and out == "" and "none of the 6 clips" in err and "64x48" in err
+
+
+def test_a_damaged_sidecar_skips_its_clip_with_a_warning(sims, run_cli, tmp_path):
+    for stem in ("empty", "walk"):
+        for ext in (".mp4", ".json"):
+            shutil.copy(sims / f"{stem}{ext}", tmp_path / f"{stem}{ext}")
+    (tmp_path / "walk.json").write_text("{bad")
+    code, out, err = run_cli("evaluate", tmp_path, "--task", "count", "--json", "--jobs", "1")
+    assert code == 0, err
+    res = json.loads(out)
+    assert res["clips"] == 1 and [r["file"] for r in res["rows"]] == ["empty.mp4"] and res["skipped"] == ["walk.mp4"]
+    (why,) = res["skipped_reasons"]
+    assert why["file"] == "walk.mp4" and why["reason"].startswith("damaged sidecar: walk.json")
+    assert "Warning: walk.mp4 skipped: damaged sidecar: walk.json" in " ".join(err.split())

@@ -1,5 +1,7 @@
-"""Reading a folder's labels: one clip named two ways."""
+"""Reading a folder's labels: one clip named two ways, damaged sidecars."""
 from __future__ import annotations
+
+import json
 
 import pytest
 
@@ -21,3 +23,19 @@ def test_one_clip_named_two_ways_is_a_duplicate(tmp_path, other, run_cli):
         read_labels(d)
     code, out, err = run_cli("evaluate", d, "--task", "count")
     assert code == 1 and out == "" and err.startswith("Error:") and len(err.splitlines()) == 1
+
+
+def test_a_damaged_sidecar_beside_its_video_is_reported_not_dropped(tmp_path):
+    for stem in ("a", "b", "c"):
+        (tmp_path / f"{stem}.mp4").write_bytes(b"x")
+    (tmp_path / "a.json").write_text("{bad")
+    (tmp_path / "b.json").write_text(json.dumps({"people": 1, "activity": "walking", "activities": ["walking"]}))
+    (tmp_path / "c.json").write_text(json.dumps({"people": 1}))
+    (tmp_path / "notes.json").write_text("{also bad, but no video of that name: not a sidecar")
+    labels = read_labels(tmp_path)
+    assert [c.file for c in labels.clips] == ["b.mp4"]
+    assert [f for f, _ in labels.damaged] == ["a.mp4", "c.mp4"]
+    assert "a.json" in labels.damaged[0][1] and "'activity'" in labels.damaged[1][1]
+    (tmp_path / "b.json").write_text("[")
+    with pytest.raises(WallcliError, match="3 damaged"):
+        read_labels(tmp_path)

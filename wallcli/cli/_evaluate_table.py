@@ -86,6 +86,9 @@ def print_evaluation(res: dict) -> None:
     if show_det:
         lines.append(["all clips", *figures(res["all"], res["all"]["ci95"])])
     title = "Summary (accuracy: 95 % bootstrap interval over clips; decided: answers not undetermined)"
-    if res["skipped"]:
-        title += f"; {len(res['skipped'])} clips of more than one person skipped"
+    two = sum(s["reason"].startswith("more than one person") for s in res["skipped_reasons"])
+    if two:
+        title += f"; {two} clips of more than one person skipped"
+    if len(res["skipped"]) > two:
+        title += f"; {len(res['skipped']) - two} clips with a damaged sidecar skipped"
     print_table(title, ["clips", "scored", "right", "decided", "right of decided", "errors"], lines)

@@ -34,8 +34,9 @@ def evaluate(
     measured SNR and per class, and how many answers were decided (not 'undetermined') and
     how often those were right. With a 'detectable' column, the headline figures are on
     detectable clips and the same on all clips follow. For activity, clips with more than
-    one person are skipped. A clip that cannot be analysed (missing, corrupt, too short) is
-    a row with its error and counts as wrong.
+    one person are skipped; so is a clip whose sidecar is damaged, with a warning. A clip
+    that cannot be analysed (missing, corrupt, too short) is a row with its error and counts
+    as wrong.
 
     \b
     labels.csv (other columns are ignored):
@@ -57,12 +58,15 @@ def evaluate(
 
     roi_t = parse_roi(roi)
 
-    from wallcli.cli.output import emit_json, progress
+    from wallcli.cli.output import emit_json, progress, warn
     from wallcli.evaluate import evaluate_folder
     from wallcli.evaluate.labels import read_labels
     from wallcli.io.writer import check_outputs
 
-    clips, _ = read_labels(folder)  # fails early (exit 1) on a folder without labels
+    labels = read_labels(folder)  # fails early (exit 1) on a folder without labels
+    for file, why in labels.damaged:
+        warn(f"{file} skipped: {why}")
+    clips = labels.clips
     check_outputs([plot], force=force, inputs=[model, *(c.path for c in clips)])
     total = sum(task == "count" or c.persons <= 1 for c in clips)  # activity skips clips of two people
     with progress(f"evaluate {task}", total) as advance:

@@ -12,6 +12,8 @@ from wallcli.evaluate.clip import init_worker, run_clip
 from wallcli.evaluate.labels import Clip, read_labels
 from wallcli.evaluate.pool import imap_isolated
 
+TWO_PEOPLE = "more than one person (activity is defined for one)"
+
 
 def default_jobs() -> int:
     try:
@@ -27,18 +29,19 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
     error (and a wrong answer); labels that cannot be read raise WallcliError."""
     from wallcli.infer.model import load_model
 
-    clips, source = read_labels(folder)
+    labels = read_labels(folder)
     model = load_model(task, model_path)  # checked here once: a bad model fails before any worker starts
     classes = model.classes
     kept, skipped = [], []
-    for c in clips:
+    for c in labels.clips:
         if task == "activity" and c.persons > 1:
-            skipped.append(c.file)  # activity is defined for one person
+            skipped.append((c.file, TWO_PEOPLE))
             continue
         if c.truth(task) not in classes:
             raise WallcliError(f"{c.file}: its label {c.truth(task)!r} is not one of the {task} model's classes "
                                f"({', '.join(map(str, classes))})")
         kept.append(c)
+    skipped += labels.damaged
 
     stride = int(model.card["stride"])
     outcome: dict[int, dict] = {}
@@ -65,8 +68,8 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
         raise WallcliError(f"none of the {len(rows)} clips could be analysed (first, {rows[0]['file']}: "
                            f"{rows[0]['error']})")
     if not rows:
-        raise WallcliError(f"{folder}: no clip to score ({len(skipped)} clips of more than one person skipped)")
-    return report(rows, task=task, model=model.info(), classes=classes, folder=str(folder), labels=source,
+        raise WallcliError(f"{folder}: no clip to score ({len(skipped)} skipped: {skipped[0][1]})")
+    return report(rows, task=task, model=model.info(), classes=classes, folder=str(folder), labels=labels.source,
                   skipped=skipped, stride=stride, roi=roi)
 
 
@@ -91,8 +94,8 @@ def _row(clip: Clip, out: dict, task: str) -> dict[str, Any]:
 
 
 def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: str, labels: str,
-           skipped: list[str], stride: int, roi) -> dict[str, Any]:
-    """The CONTRACT.md object from finished rows."""
+           skipped: list[tuple[str, str]], stride: int, roi) -> dict[str, Any]:
+    """The CONTRACT.md object from finished rows; ``skipped`` holds (file, why) pairs."""
     for r in rows:
         r["correct"] = score.correct(r)
     given = any(r["detectable"] is not None for r in rows)
@@ -125,7 +128,8 @@ def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: s
         "per_class": score.per_class(head, classes),
         "by_snr": score.by_snr(head),
         "reliability": score.reliability(head),
-        "skipped": skipped,
+        "skipped": [f for f, _ in skipped],
+        "skipped_reasons": [{"file": f, "reason": why} for f, why in skipped],
         "labels": labels,
         "stride": stride,
         "roi": list(roi) if roi else None,
