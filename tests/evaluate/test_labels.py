@@ -1,4 +1,4 @@
-"""Reading a folder's labels: one clip named two ways, damaged sidecars."""
+"""Reading a folder's labels: one clip named two ways, the snr_db column, damaged sidecars."""
 from __future__ import annotations
 
 import json
@@ -23,6 +23,23 @@ def test_one_clip_named_two_ways_is_a_duplicate(tmp_path, other, run_cli):
         read_labels(d)
     code, out, err = run_cli("evaluate", d, "--task", "count")
     assert code == 1 and out == "" and err.startswith("Error:") and len(err.splitlines()) == 1
+
+
+def test_snr_db_column_is_read_and_an_empty_cell_is_an_empty_room(tmp_path):
+    d = _folder(tmp_path, "file,people,activity,snr_db\na.mp4,1,walking,-3.5\nb.mp4,0,none,\n")
+    labels = read_labels(d)
+    assert labels.has_snr and [c.snr_db for c in labels.clips] == [-3.5, None]
+    assert [c.empty("count") for c in labels.clips] == [False, True]
+    (d / "labels.csv").write_text("file,people,activity\na.mp4,1,walking\n")
+    assert not read_labels(d).has_snr and read_labels(d).clips[0].snr_db is None
+
+
+@pytest.mark.parametrize("cell,message", [("", "empty 'snr_db' where people = 2"), ("nan", "'snr_db' must be a number"),
+                                          ("inf", "'snr_db' must be"), ("loud", "'snr_db' must be")])
+def test_bad_snr_cells_name_the_line(tmp_path, cell, message):
+    d = _folder(tmp_path, f"file,people,activity,snr_db\nb.mp4,0,none,\na.mp4,2,mixed,{cell}\n")
+    with pytest.raises(WallcliError, match=f"line 3: {message}"):
+        read_labels(d)
 
 
 def test_a_damaged_sidecar_beside_its_video_is_reported_not_dropped(tmp_path):

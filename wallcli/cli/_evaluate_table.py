@@ -3,7 +3,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from wallcli.cli.output import print_table
+from wallcli.cli.output import print_lines, print_table
+
+BAND_NAMES = {"empty": "empty rooms", "<0 dB": "under 0 dB", "0-10 dB": "0-10 dB", ">=10 dB": "10 dB and over",
+              "not measured": "SNR unknown"}
+
+
+def plural(n: int, noun: str) -> str:
+    """'1 clip', '2 clips', '1 person', '2 people'."""
+    return f"{n} {noun if n == 1 else {'person': 'people'}.get(noun, noun + 's')}"
 
 
 def _pct(x: float | None, digits: int = 0) -> str:
@@ -12,6 +20,11 @@ def _pct(x: float | None, digits: int = 0) -> str:
 
 def _ci(iv) -> str:
     return "" if not iv else f" ({100 * iv[0]:.0f}-{100 * iv[1]:.0f})"
+
+
+def _of(k: int, n: int, digits: int = 0) -> str:
+    """'3 (75 %)': k and its share of n."""
+    return f"{k} ({_pct(k / n, digits)})" if n else "-"
 
 
 def _answer(r: dict) -> str:
@@ -26,15 +39,18 @@ def _snr(r: dict) -> str:
     return "-" if r["snr_db"] is None else f"{r['snr_db']:.1f}"
 
 
-def _band(b: Any) -> str:
-    if b is None:
-        return "not measured"
-    lo, hi = b
-    if lo is None:
-        return f"< {hi:g} dB"
-    if hi is None:
-        return f">= {lo:g} dB"
-    return f"{lo:g} to {hi:g} dB"
+def _bands(res: dict) -> None:
+    rows = [[BAND_NAMES.get(b["band"], b["band"]), str(b["clips"]), _of(b["correct"], b["clips"]), str(b["decided"]),
+             _of(b["correct_decided"], b["decided"])] for b in res["by_band"]]
+    labels = res["snr_source"] == "labels"
+    print_table(f"By SNR band, all {plural(sum(b['clips'] for b in res['by_band']), 'scored clip')} "
+                f"(SNR: {'labels.csv snr_db' if labels else 'measured'})",
+                ["band", "clips", "right", "decided", "right of decided"], rows)
+    lines = [] if labels else ["The labels give no snr_db: bands are on the measured SNR (see the SNR column)."]
+    if res.get("min_snr") is not None:
+        lines.append(f"--min-snr {res['min_snr']:g}: {plural(res['excluded'], 'clip')} under {res['min_snr']:g} dB "
+                     "left out of every figure")
+    print_lines(lines)
 
 
 def print_evaluation(res: dict) -> None:
@@ -68,11 +84,7 @@ def print_evaluation(res: dict) -> None:
     print_table(f"Confusion on {on} (rows: truth, columns: answer; accuracy with its 95 % Wilson interval)",
                 ["truth", *map(str, classes), *(["error"] if errs else []), "accuracy"], conf)
 
-    bands = [[_band(b["snr_db"]), f"{b['correct']}/{b['clips']} {_pct(b['accuracy'])}{_ci(b['ci95'])}",
-              f"{b['decided']}", _pct(b["accuracy_decided"])] for b in res["by_snr"]]
-    if bands:
-        print_table(f"Accuracy by measured SNR on {on} (green channel at the plot bins' block size)",
-                    ["measured SNR", "right", "decided", "accuracy of decided"], bands)
+    _bands(res)
 
     def figures(block: dict, ci: Any) -> list[str]:
         return [str(block["scored"]), f"{block['correct']}/{block['scored']} {_pct(block['accuracy'], 1)}{_ci(ci)}",

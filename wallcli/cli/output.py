@@ -85,6 +85,12 @@ def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
     console_out.print(table)
 
 
+def print_lines(lines: list[str]) -> None:
+    """Lines of text on stdout (notes under a table), wrapped to the terminal's width."""
+    for line in lines:
+        console_out.print(printable(line))
+
+
 # --------------------------------------------------------------------------------------- stdout
 class StdoutError(WallcliError):
     """stdout cannot take the data: the user's environment (a full disk, a closed stdout), not a bug."""

@@ -2,19 +2,20 @@
 
 ``labels.csv`` needs the columns ``file``, ``people`` and ``activity`` (``people`` counts the
 people who *move*: someone standing still is 0, as ``wallcli count`` counts); ``detectable`` (0/1)
-is optional and every other column is ignored. A sidecar's ``people`` counts everyone in the room,
-so a count's truth there is the number of its ``activities`` other than ``none`` (what
-tests/test_examples.py checks the shipped models against). A labels.csv that cannot be read is a
-failure of the whole run (exit 1, naming the line); a clip that is missing is not: it becomes that
-clip's error row. A sidecar is one clip's labels, so a damaged one (beside its video) skips that
-clip, with the reason, rather than failing the run. Two names for one file (``a.mp4``,
-``./a.mp4``) are one clip listed twice: an error, as any duplicate is, since scoring it twice
-would weigh it double.
+and ``snr_db`` (the known SNR; empty for an empty room) are optional and every other column is
+ignored. A sidecar's ``people`` counts everyone in the room, so a count's truth there is the number
+of its ``activities`` other than ``none`` (what tests/test_examples.py checks the shipped models
+against). A labels.csv that cannot be read is a failure of the whole run (exit 1, naming the line);
+a clip that is missing is not: it becomes that clip's error row. A sidecar is one clip's labels, so
+a damaged one (beside its video) skips that clip, with the reason, rather than failing the run.
+Two names for one file (``a.mp4``, ``./a.mp4``) are one clip listed twice: an error, as any
+duplicate is, since scoring it twice would weigh it double.
 """
 from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,15 +35,21 @@ class Clip:
     activity: str
     detectable: bool | None  # None: not given
     persons: int  # everyone in the room, still or not: activity is defined for at most one
+    snr_db: float | None = None  # the labels' SNR; None for an empty room or without the column
 
     def truth(self, task: str) -> Any:
         return self.people if task == "count" else self.activity
+
+    def empty(self, task: str) -> bool:
+        """An empty room: nobody moves (and, for activity, the label says so)."""
+        return self.people == 0 and (task == "count" or self.activity == "none")
 
 
 @dataclass(frozen=True)
 class Labels:
     clips: list[Clip]  # in the labels' order
     source: str  # 'labels.csv' or 'sidecars'
+    has_snr: bool  # the labels give each clip's SNR (an snr_db column)
     damaged: list[tuple[str, str]] = field(default_factory=list)  # (clip, why its sidecar cannot be used)
 
 
@@ -53,13 +60,14 @@ def read_labels(folder: str | Path) -> Labels:
     if not d.is_dir():
         raise WallcliError(f"{folder} is not a folder; give the folder that holds the clips and their labels")
     if (d / LABELS).is_file():
-        return Labels(_from_csv(d), LABELS)
+        clips, has_snr = _from_csv(d)
+        return Labels(clips, LABELS, has_snr)
     clips, damaged = _from_sidecars(d)
     if not clips:
         why = f" ({len(damaged)} damaged: {damaged[0][1]})" if damaged else ""
         raise WallcliError(f"{folder} has no labels: looked for {LABELS} (columns {', '.join(REQUIRED)}) and for "
                            f"*.json sidecars with 'people' and 'activity' (as 'wallcli simulate' writes them){why}")
-    return Labels(clips, "sidecars", damaged)
+    return Labels(clips, "sidecars", False, damaged)
 
 
 def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
@@ -74,7 +82,7 @@ def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
         seen[key] = (where, c)
 
 
-def _from_csv(d: Path) -> list[Clip]:
+def _from_csv(d: Path) -> tuple[list[Clip], bool]:
     path = d / LABELS
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
@@ -85,17 +93,18 @@ def _from_csv(d: Path) -> list[Clip]:
                 raise WallcliError(f"{path} lacks the column(s) {', '.join(missing)} (needs {', '.join(REQUIRED)}; "
                                    f"has {', '.join(header) or 'none'})")
             reader.fieldnames = header
-            named = [(f"line {n}", _csv_row(path, n, row)) for n, row in enumerate(reader, start=2)
+            has_snr = "snr_db" in header
+            named = [(f"line {n}", _csv_row(path, n, row, has_snr)) for n, row in enumerate(reader, start=2)
                      if any((v or "").strip() for v in row.values() if isinstance(v, str))]
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise WallcliError(f"cannot read {path}: {exc}") from None
     if not named:
         raise WallcliError(f"{path} lists no clips")
     _no_duplicates(path, named)
-    return [c for _, c in named]
+    return [c for _, c in named], has_snr
 
 
-def _csv_row(path: Path, line: int, row: dict) -> Clip:
+def _csv_row(path: Path, line: int, row: dict, has_snr: bool) -> Clip:
     where = f"{path} line {line}"
     name = (row.get("file") or "").strip()
     if not name:
@@ -107,7 +116,25 @@ def _csv_row(path: Path, line: int, row: dict) -> Clip:
     det = (row.get("detectable") or "").strip()
     if det not in ("", "0", "1"):
         raise WallcliError(f"{where}: 'detectable' must be 0 or 1 (got {det!r})")
-    return Clip(name, path.parent / name, people, activity, None if det == "" else det == "1", people)
+    snr = _snr(row.get("snr_db"), people, where) if has_snr else None
+    return Clip(name, path.parent / name, people, activity, None if det == "" else det == "1", people, snr)
+
+
+def _snr(value: Any, people: int, where: str) -> float | None:
+    text = (value or "").strip()
+    if not text:
+        if people:  # the band table would have to guess, so say so now
+            raise WallcliError(f"{where}: empty 'snr_db' where people = {people} (an empty cell "
+                               "means an empty room; give its SNR, or drop the column to use the measured SNR)")
+        return None
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not math.isfinite(x):
+        raise WallcliError(f"{where}: 'snr_db' must be a number of dB (got {text!r})")
+    return x
+
 
 
 def _people(value: Any, where: str) -> int:
