@@ -65,7 +65,7 @@ def test_count_with_labels_csv_is_what_the_single_command_answers(labelled, sing
 def test_activity_from_sidecars_skips_two_people_and_prints_a_table(sims, single, run_cli):
     code, out, err = run_cli("evaluate", sims, "--task", "activity", "--jobs", "1")
     assert code == 0, err
-    assert "two.mp4" not in out and "1 clips of more than one person skipped" in " ".join(out.split())
+    assert "two.mp4" not in out and "1 clip skipped: more than one person" in " ".join(out.split())
     code, out, err = run_cli("evaluate", sims, "--task", "activity", "--json", "--jobs", "2")
     res = json.loads(out)
     assert "all" not in res and res["skipped"] == ["two.mp4"] and res["labels"] == "sidecars"

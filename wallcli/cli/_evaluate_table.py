@@ -1,7 +1,9 @@
-"""The table view of ``wallcli evaluate``: per-clip rows, then the figures (all via output.py)."""
-from __future__ import annotations
+"""The table view of ``wallcli evaluate``: per-clip rows, then the figures (all via output.py).
 
-from typing import Any
+Every table fits 80 columns: what is long (the reason an answer is undetermined, a clip's error)
+goes to numbered footnotes under the per-clip table, and the JSON has all of it.
+"""
+from __future__ import annotations
 
 from wallcli.cli.output import print_lines, print_table
 
@@ -18,25 +20,64 @@ def _pct(x: float | None, digits: int = 0) -> str:
     return "-" if x is None else f"{100 * x:.{digits}f} %"
 
 
-def _ci(iv) -> str:
-    return "" if not iv else f" ({100 * iv[0]:.0f}-{100 * iv[1]:.0f})"
-
-
 def _of(k: int, n: int, digits: int = 0) -> str:
     """'3 (75 %)': k and its share of n."""
     return f"{k} ({_pct(k / n, digits)})" if n else "-"
 
 
-def _answer(r: dict) -> str:
-    if r["error"] is not None:
-        return "error (below)"
-    if r["confident"] is False:
-        return f"undetermined ({r.get('reason') or 'no reason given'})"
-    return str(r["label"])
-
-
 def _snr(r: dict) -> str:
-    return "-" if r["snr_db"] is None else f"{r['snr_db']:.1f}"
+    # whole dB: the estimate is good to a few dB at best (lossy clips read high), and 80 columns have no room
+    return "-" if r["snr_db"] is None else str(round(r["snr_db"]))
+
+
+class _Notes:
+    """Numbered footnotes, one per distinct text: 40 clips undetermined for one reason take one line."""
+
+    def __init__(self) -> None:
+        self.texts: list[str] = []
+
+    def mark(self, text: str) -> str:
+        if text not in self.texts:
+            self.texts.append(text)
+        return f"[{self.texts.index(text) + 1}]"
+
+    def lines(self) -> list[str]:
+        return [f"[{i}] {t}" for i, t in enumerate(self.texts, start=1)]
+
+
+def _clips(res: dict, show_det: bool) -> None:
+    notes = _Notes()
+    cols = ["file", "truth", "answer", "p %", "SNR", "ok"]
+    if show_det:
+        cols.insert(1, "det")
+    rows = []
+    for r in res["rows"]:
+        if r["error"] is not None:
+            answer = "error " + notes.mark(r["error"])
+        elif r["confident"] is False:
+            answer = "undetermined " + notes.mark(r.get("reason") or "no reason given")
+        else:
+            answer = str(r["label"])
+        p = "-" if not r["probabilities"] else f"{100 * max(r['probabilities']):.0f}"
+        row = [r["file"], str(r["truth"]), answer, p, _snr(r), "yes" if r["correct"] else "no"]
+        if show_det:
+            row.insert(1, {True: "yes", False: "no", None: "?"}[r["detectable"]])
+        rows.append(row)
+    m = res["model"]
+    print_table(f"{res['dir']}: {res['task']} by {m['name']} {m['version']}, {plural(res['clips'], 'clip')} "
+                f"(labels: {res['labels']})", cols, rows, pad_edge=False)
+    print_lines(notes.lines(), hang=len(f"[{len(notes.texts)}] "))
+    print_lines(["p %: probability of the label; SNR: measured, dB" + ("; det: labelled detectable" if show_det else "")])
+
+
+def _confusion(res: dict) -> None:
+    classes = res["classes"]
+    errs = any(res["errors_by_class"])
+    rows = [[str(c), *(str(n) for n in res["confusion"][i]), *([str(res["errors_by_class"][i])] if errs else []),
+             f"{pc['correct']}/{pc['clips']} {_pct(pc['accuracy'])}"]
+            for i, (c, pc) in enumerate(zip(classes, res["per_class"]))]
+    print_table(f"Confusion on {res['scored_on']} (rows: truth, columns: answer)",
+                ["truth", *map(str, classes), *(["err"] if errs else []), "right"], rows)
 
 
 def _bands(res: dict) -> None:
@@ -53,54 +94,32 @@ def _bands(res: dict) -> None:
     print_lines(lines)
 
 
+def _summary(res: dict, show_det: bool) -> None:
+    # one column per set of clips (narrow whatever the figures), one row per figure
+    head = {k: res[k] for k in ("scored", "correct", "accuracy", "ci95", "decided", "correct_decided")}
+    blocks = {res["scored_on"].split()[0]: dict(head, errors=sum(res["errors_by_class"]))}
+    if show_det:
+        blocks["all"] = res["all"]
+    figures = [
+        ("scored", lambda b: str(b["scored"])),
+        ("right", lambda b: f"{b['correct']} ({_pct(b['accuracy'], 1)})"),
+        ("95 % interval", lambda b: "-" if not b["ci95"] else f"{100 * b['ci95'][0]:.0f}-{100 * b['ci95'][1]:.0f} %"),
+        ("decided", lambda b: _of(b["decided"], b["scored"])),
+        ("right of decided", lambda b: _of(b["correct_decided"], b["decided"], 1)),
+        ("errors", lambda b: str(b["errors"])),
+    ]
+    print_table("Summary (95 % interval: bootstrap over clips; decided: answers not undetermined)",
+                ["clips", *blocks], [[name, *(f(b) for b in blocks.values())] for name, f in figures])
+    by_reason: dict[str, int] = {}
+    for s in res.get("skipped_reasons", []):
+        by_reason[s["reason"]] = by_reason.get(s["reason"], 0) + 1
+    print_lines([f"{plural(n, 'clip')} skipped: {why}" for why, n in by_reason.items()])
+
+
 def print_evaluation(res: dict) -> None:
-    classes = res["classes"]
-    given = "all" in res
-    m = res["model"]
-    # a detectable column only where it tells the rows apart; probabilities in % to fit 80 columns
+    # a detectable column only where it tells the rows apart
     show_det = any(r["detectable"] is False for r in res["rows"])
-    cols = ["file", "truth", "answer", "p %", "SNR dB", "ok"]
-    if show_det:
-        cols.insert(1, "det.")
-    rows = []
-    for r in res["rows"]:
-        p = "-" if not r["probabilities"] else " ".join(f"{100 * x:.0f}" for x in r["probabilities"])
-        row = [r["file"], str(r["truth"]), _answer(r), p, _snr(r), "yes" if r["correct"] else "no"]
-        if show_det:
-            row.insert(1, {True: "yes", False: "no", None: "?"}[r["detectable"]])
-        rows.append(row)
-    print_table(f"{res['dir']}: {res['task']} by {m['name']} {m['version']}, {res['clips']} clips "
-                f"(labels: {res['labels']}); p % of " + ", ".join(map(str, classes)), cols, rows)
-
-    failed = [[r["file"], r["error"]] for r in res["rows"] if r["error"] is not None]
-    if failed:
-        print_table("Clips that failed (each counts as a wrong answer)", ["file", "error"], failed)
-
-    on = res["scored_on"]
-    errs = any(res["errors_by_class"])
-    conf = [[str(c), *(str(n) for n in res["confusion"][i]), *([str(res["errors_by_class"][i])] if errs else []),
-             f"{pc['correct']}/{pc['clips']} {_pct(pc['accuracy'])}{_ci(pc['ci95'])}"]
-            for i, (c, pc) in enumerate(zip(classes, res["per_class"]))]
-    print_table(f"Confusion on {on} (rows: truth, columns: answer; accuracy with its 95 % Wilson interval)",
-                ["truth", *map(str, classes), *(["error"] if errs else []), "accuracy"], conf)
-
+    _clips(res, show_det)
+    _confusion(res)
     _bands(res)
-
-    def figures(block: dict, ci: Any) -> list[str]:
-        return [str(block["scored"]), f"{block['correct']}/{block['scored']} {_pct(block['accuracy'], 1)}{_ci(ci)}",
-                f"{block['decided']} ({_pct(block['coverage'])})", _pct(block["accuracy_decided"], 1),
-                str(block["errors"])]
-
-    head = {"scored": res["scored"], "correct": res["correct"], "accuracy": res["accuracy"],
-            "decided": res["decided"], "coverage": res["coverage"], "accuracy_decided": res["accuracy_decided"],
-            "errors": sum(res["errors_by_class"])}
-    lines = [[on, *figures(head, res["ci95"])]]
-    if show_det:
-        lines.append(["all clips", *figures(res["all"], res["all"]["ci95"])])
-    title = "Summary (accuracy: 95 % bootstrap interval over clips; decided: answers not undetermined)"
-    two = sum(s["reason"].startswith("more than one person") for s in res["skipped_reasons"])
-    if two:
-        title += f"; {two} clips of more than one person skipped"
-    if len(res["skipped"]) > two:
-        title += f"; {len(res['skipped']) - two} clips with a damaged sidecar skipped"
-    print_table(title, ["clips", "scored", "right", "decided", "right of decided", "errors"], lines)
+    _summary(res, show_det)

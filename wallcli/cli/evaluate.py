@@ -8,6 +8,8 @@ import typer
 
 from wallcli.cli.common import FORCE_HELP, MAX_THREADS, ROI_HELP, number_option
 
+PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
+
 
 def evaluate(
     folder: Path = typer.Argument(..., metavar="DIR", show_default=False,
@@ -32,8 +34,8 @@ def evaluate(
 
     Each clip is decoded once, classified exactly as 'wallcli count' / 'activity' would
     (same model, windows and stride) and its SNR measured (green channel, wallcli snr's
-    estimator at the block size of one space-time plot bin). Prints one row per clip,
-    the confusion matrix with accuracy per class, clips right
+    estimator at the block size of one space-time plot bin). Prints one row per clip
+    (long reasons as footnotes), the confusion matrix with accuracy per class, clips right
     by SNR band (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db
     column where there is one, else on the measured SNR), accuracy with a 95 % bootstrap
     interval over clips, and how many answers were decided (not 'undetermined') and how
@@ -73,7 +75,8 @@ def evaluate(
     for file, why in plan.labels.damaged:
         warn(f"{file} skipped: {why}")
     check_outputs([plot], force=force, inputs=[model, *(c.path for c in plan.labels.clips)])
-    with progress(f"evaluate {task}", len(plan.kept)) as advance:
+    # delayed: on a small folder a bar would only flash; on a large one it shows the minutes left
+    with progress(f"evaluate {task}", len(plan.kept), delay=PROGRESS_DELAY) as advance:
         result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan)
     if plot is not None:
         from wallcli.plots.reliability import save_reliability_png
