@@ -52,6 +52,7 @@ def test_bands_from_the_labels_snr_cover_every_clip(with_snr, run_cli):
                                                        "crouch.mp4": "<0 dB", "stand.mp4": "empty", "two.mp4": ">=10 dB"}
     assert [list(b) for b in res["by_band"]] == [BAND_KEYS] * 4
     assert [b["snr_db"] for b in res["by_band"]] == [[None, None], [None, 0], [0, 10], [10, None]]
+    assert '"snr_db": [null, 0], "band": "<0 dB"' in out  # CONTRACT.md's very text
     assert [b["clips"] for b in res["by_band"]] == [2, 1, 1, 2]
     for b in res["by_band"]:
         assert [b["clips"], b["correct"], b["decided"], b["correct_decided"]] == _figures(res["rows"], b["band"])

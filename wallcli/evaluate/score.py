@@ -22,7 +22,7 @@ Z95 = 1.959963984540054
 SNR_EDGES = (-5.0, 0.0, 5.0, 10.0)
 # CONTRACT.md's by_band: (name, [lo, hi) in dB). Under 0 dB a person is hard to tell from an empty
 # room; from 10 dB up plain to see in a space-time plot (the transfer set's README).
-BANDS = (("empty", None, None), ("<0 dB", None, 0.0), ("0-10 dB", 0.0, 10.0), (">=10 dB", 10.0, None))
+BANDS = (("empty", None, None), ("<0 dB", None, 0), ("0-10 dB", 0, 10), (">=10 dB", 10, None))
 UNMEASURED = "not measured"
 CONFIDENCE_BINS = 10
 
