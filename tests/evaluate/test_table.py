@@ -44,7 +44,7 @@ def test_sixty_clips_fit_80_columns_one_line_each(monkeypatch, capsys):
     text = "\n".join(lines)
     assert "undetermined [1]" in text and "\n[1] p=0.001 for 'none' at -19 dB; 97% right only from p=0.994" in text
     assert "error [" in text and "Invalid data found" in text.split("└", 1)[1]
-    assert "60 clips" in lines[0] and "\n1 clip skipped: more than one person" in text
+    assert lines[:2] == ["transfer (labels: labels.csv)", "activity by wallcli-activity 0.3.1, 60 clips"] and "\n1 clip skipped: more than one person" in text
     assert len(lines) < 2 * 60 + 40  # footnotes: a line or two each, not five lines a row as before
 
 

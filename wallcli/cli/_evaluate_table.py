@@ -64,8 +64,10 @@ def _clips(res: dict, show_det: bool) -> None:
             row.insert(1, {True: "yes", False: "no", None: "?"}[r["detectable"]])
         rows.append(row)
     m = res["model"]
-    print_table(f"{res['dir']}: {res['task']} by {m['name']} {m['version']}, {plural(res['clips'], 'clip')} "
-                f"(labels: {res['labels']})", cols, rows, pad_edge=False)
+    # the folder on a line of its own, which may wrap: the title line never does (it is grepped)
+    print_lines([f"{res['dir']} (labels: {res['labels']})"])
+    print_table(f"{res['task']} by {m['name']} {m['version']}, {plural(res['clips'], 'clip')}", cols, rows,
+                pad_edge=False)
     print_lines(notes.lines(), hang=len(f"[{len(notes.texts)}] "))
     print_lines(["p %: probability of the label; SNR: measured, dB" + ("; det: labelled detectable" if show_det else "")])
 
