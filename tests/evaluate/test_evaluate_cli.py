@@ -7,72 +7,11 @@ import shutil
 from pathlib import Path
 
 import pytest
+from scenes import SCENES
 
-SMALL = ["--duration", "10.5", "--size", "64x48", "--grid", "16x16"]
-# (stem, people, activity, seed): every count class, a standing person (counted 0), two people
-SCENES = [("empty", 0, "none", 1), ("walk", 1, "walking", 3), ("jump", 1, "jumping", 3),
-          ("crouch", 1, "crouching", 5), ("stand", 1, "none", 2), ("two", 2, "walking,crouching", 3)]
 CONTRACT = ("task", "model", "dir", "clips", "scored", "errors", "accuracy", "ci95", "decided", "coverage",
             "accuracy_decided", "classes", "confusion", "rows")
 ROW = ("file", "truth", "label", "confident", "probabilities", "snr_db", "detectable", "error")
-
-
-def _cli(*args) -> tuple[int, str]:
-    """In-process `wallcli ARGS` for module fixtures (run_cli is per test): (exit code, stdout)."""
-    import contextlib
-    import io
-
-    from wallcli.cli.app import main
-
-    buf = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(buf):
-            main([str(a) for a in args])
-    except SystemExit as exc:
-        return (exc.code if isinstance(exc.code, int) else 1), buf.getvalue()
-    return 0, buf.getvalue()
-
-
-@pytest.fixture(scope="module")
-def sims(tmp_path_factory):
-    """Simulated clips with their sidecars (the sidecar mode's folder)."""
-    d = tmp_path_factory.mktemp("sims")
-    for stem, people, act, seed in SCENES:
-        code, _ = _cli("simulate", "-o", d / f"{stem}.mp4", "--people", people, "--activity", act,
-                       "--seed", seed, *SMALL)
-        assert code == 0
-    return d
-
-
-@pytest.fixture(scope="module")
-def single(sims):
-    """What `wallcli count/activity CLIP --json` answer on each clip."""
-    out = {}
-    for task in ("count", "activity"):
-        for stem, *_ in SCENES:
-            code, text = _cli(task, sims / f"{stem}.mp4", "--json")
-            assert code == 0
-            out[task, f"{stem}.mp4"] = json.loads(text)
-    return out
-
-
-@pytest.fixture(scope="module")
-def labelled(sims, tmp_path_factory):
-    """The same clips with a labels.csv, plus a corrupt clip, a too-short one and a missing one."""
-    d = tmp_path_factory.mktemp("labelled")
-    lines = ["file,people,activity,detectable,lighting"]
-    for stem, people, act, _ in SCENES:
-        shutil.copy(sims / f"{stem}.mp4", d / f"{stem}.mp4")
-        moving = sum(a != "none" for a in act.split(","))
-        det = 0 if stem == "crouch" else 1
-        lines.append(f"{stem}.mp4,{moving},{'mixed' if people == 2 else act},{det},lamp")
-    data = (sims / "walk.mp4").read_bytes()
-    (d / "corrupt.mp4").write_bytes(data[: len(data) // 3])  # cut short: the index (moov) at the end is lost
-    code, _ = _cli("simulate", "-o", d / "short.mp4", "--duration", "3", "--size", "64x48", "--grid", "8x8")
-    assert code == 0
-    lines += ["corrupt.mp4,1,walking,1,lamp", "short.mp4,1,walking,1,lamp", "gone.mp4,0,none,1,lamp"]
-    (d / "labels.csv").write_text("\n".join(lines) + "\n")
-    return d
 
 
 def test_count_with_labels_csv_is_what_the_single_command_answers(labelled, single, run_cli, tmp_path):
@@ -126,7 +65,7 @@ def test_count_with_labels_csv_is_what_the_single_command_answers(labelled, sing
 def test_activity_from_sidecars_skips_two_people_and_prints_a_table(sims, single, run_cli):
     code, out, err = run_cli("evaluate", sims, "--task", "activity", "--jobs", "1")
     assert code == 0, err
-    assert "two.mp4" not in out and "1 clips of more than one person skipped" in " ".join(out.split())
+    assert "two.mp4" not in out and "1 clip skipped: more than one person" in " ".join(out.split())
     code, out, err = run_cli("evaluate", sims, "--task", "activity", "--json", "--jobs", "2")
     res = json.loads(out)
     assert "all" not in res and res["skipped"] == ["two.mp4"] and res["labels"] == "sidecars"
@@ -194,3 +133,17 @@ def test_one_decode_per_clip_gives_both_the_answer_and_the_snr(sims, single, mon
 def test_an_roi_outside_every_frame_fails_the_run(sims, run_cli):
     code, out, err = run_cli("evaluate", sims, "--task", "count", "--roi", "0,0,500,500", "--jobs", "1")
     assert code == 1 and out == "" and "none of the 6 clips" in err and "64x48" in err
+
+
+def test_a_damaged_sidecar_skips_its_clip_with_a_warning(sims, run_cli, tmp_path):
+    for stem in ("empty", "walk"):
+        for ext in (".mp4", ".json"):
+            shutil.copy(sims / f"{stem}{ext}", tmp_path / f"{stem}{ext}")
+    (tmp_path / "walk.json").write_text("{bad")
+    code, out, err = run_cli("evaluate", tmp_path, "--task", "count", "--json", "--jobs", "1")
+    assert code == 0, err
+    res = json.loads(out)
+    assert res["clips"] == 1 and [r["file"] for r in res["rows"]] == ["empty.mp4"] and res["skipped"] == ["walk.mp4"]
+    (why,) = res["skipped_reasons"]
+    assert why["file"] == "walk.mp4" and why["reason"].startswith("damaged sidecar: walk.json")
+    assert "Warning: walk.mp4 skipped: damaged sidecar: walk.json" in " ".join(err.split())

@@ -1,91 +1,127 @@
-"""The table view of ``wallcli evaluate``: per-clip rows, then the figures (all via output.py)."""
+"""The table view of ``wallcli evaluate``: per-clip rows, then the figures (all via output.py).
+
+Every table fits 80 columns: what is long (the reason an answer is undetermined, a clip's error)
+goes to numbered footnotes under the per-clip table, and the JSON has all of it.
+"""
 from __future__ import annotations
 
-from typing import Any
+from wallcli.cli.output import print_lines, print_table
 
-from wallcli.cli.output import print_table
+BAND_NAMES = {"empty": "empty rooms", "<0 dB": "under 0 dB", "0-10 dB": "0-10 dB", ">=10 dB": "10 dB and over",
+              "not measured": "SNR unknown"}
+
+
+def plural(n: int, noun: str) -> str:
+    """'1 clip', '2 clips', '1 person', '2 people'."""
+    return f"{n} {noun if n == 1 else {'person': 'people'}.get(noun, noun + 's')}"
 
 
 def _pct(x: float | None, digits: int = 0) -> str:
     return "-" if x is None else f"{100 * x:.{digits}f} %"
 
 
-def _ci(iv) -> str:
-    return "" if not iv else f" ({100 * iv[0]:.0f}-{100 * iv[1]:.0f})"
-
-
-def _answer(r: dict) -> str:
-    if r["error"] is not None:
-        return "error (below)"
-    if r["confident"] is False:
-        return f"undetermined ({r.get('reason') or 'no reason given'})"
-    return str(r["label"])
+def _of(k: int, n: int, digits: int = 0) -> str:
+    """'3 (75 %)': k and its share of n."""
+    return f"{k} ({_pct(k / n, digits)})" if n else "-"
 
 
 def _snr(r: dict) -> str:
-    return "-" if r["snr_db"] is None else f"{r['snr_db']:.1f}"
+    # whole dB: the estimate is good to a few dB at best (lossy clips read high), and 80 columns have no room
+    return "-" if r["snr_db"] is None else str(round(r["snr_db"]))
 
 
-def _band(b: Any) -> str:
-    if b is None:
-        return "not measured"
-    lo, hi = b
-    if lo is None:
-        return f"< {hi:g} dB"
-    if hi is None:
-        return f">= {lo:g} dB"
-    return f"{lo:g} to {hi:g} dB"
+class _Notes:
+    """Numbered footnotes, one per distinct text: 40 clips undetermined for one reason take one line."""
+
+    def __init__(self) -> None:
+        self.texts: list[str] = []
+
+    def mark(self, text: str) -> str:
+        if text not in self.texts:
+            self.texts.append(text)
+        return f"[{self.texts.index(text) + 1}]"
+
+    def lines(self) -> list[str]:
+        return [f"[{i}] {t}" for i, t in enumerate(self.texts, start=1)]
 
 
-def print_evaluation(res: dict) -> None:
-    classes = res["classes"]
-    given = "all" in res
-    m = res["model"]
-    # a detectable column only where it tells the rows apart; probabilities in % to fit 80 columns
-    show_det = any(r["detectable"] is False for r in res["rows"])
-    cols = ["file", "truth", "answer", "p %", "SNR dB", "ok"]
+def _clips(res: dict, show_det: bool) -> None:
+    notes = _Notes()
+    cols = ["file", "truth", "answer", "p %", "SNR", "ok"]
     if show_det:
-        cols.insert(1, "det.")
+        cols.insert(1, "det")
     rows = []
     for r in res["rows"]:
-        p = "-" if not r["probabilities"] else " ".join(f"{100 * x:.0f}" for x in r["probabilities"])
-        row = [r["file"], str(r["truth"]), _answer(r), p, _snr(r), "yes" if r["correct"] else "no"]
+        if r["error"] is not None:
+            answer = "error " + notes.mark(r["error"])
+        elif r["confident"] is False:
+            answer = "undetermined " + notes.mark(r.get("reason") or "no reason given")
+        else:
+            answer = str(r["label"])
+        p = "-" if not r["probabilities"] else f"{100 * max(r['probabilities']):.0f}"
+        row = [r["file"], str(r["truth"]), answer, p, _snr(r), "yes" if r["correct"] else "no"]
         if show_det:
             row.insert(1, {True: "yes", False: "no", None: "?"}[r["detectable"]])
         rows.append(row)
-    print_table(f"{res['dir']}: {res['task']} by {m['name']} {m['version']}, {res['clips']} clips "
-                f"(labels: {res['labels']}); p % of " + ", ".join(map(str, classes)), cols, rows)
+    m = res["model"]
+    # the folder on a line of its own, which may wrap: the title line never does (it is grepped)
+    print_lines([f"{res['dir']} (labels: {res['labels']})"])
+    print_table(f"{res['task']} by {m['name']} {m['version']}, {plural(res['clips'], 'clip')}", cols, rows,
+                pad_edge=False)
+    print_lines(notes.lines(), hang=len(f"[{len(notes.texts)}] "))
+    print_lines(["p %: probability of the label; SNR: measured, dB" + ("; det: labelled detectable" if show_det else "")])
 
-    failed = [[r["file"], r["error"]] for r in res["rows"] if r["error"] is not None]
-    if failed:
-        print_table("Clips that failed (each counts as a wrong answer)", ["file", "error"], failed)
 
-    on = res["scored_on"]
+def _confusion(res: dict) -> None:
+    classes = res["classes"]
     errs = any(res["errors_by_class"])
-    conf = [[str(c), *(str(n) for n in res["confusion"][i]), *([str(res["errors_by_class"][i])] if errs else []),
-             f"{pc['correct']}/{pc['clips']} {_pct(pc['accuracy'])}{_ci(pc['ci95'])}"]
+    rows = [[str(c), *(str(n) for n in res["confusion"][i]), *([str(res["errors_by_class"][i])] if errs else []),
+             f"{pc['correct']}/{pc['clips']} {_pct(pc['accuracy'])}"]
             for i, (c, pc) in enumerate(zip(classes, res["per_class"]))]
-    print_table(f"Confusion on {on} (rows: truth, columns: answer; accuracy with its 95 % Wilson interval)",
-                ["truth", *map(str, classes), *(["error"] if errs else []), "accuracy"], conf)
+    print_table(f"Confusion on {res['scored_on']} (rows: truth, columns: answer)",
+                ["truth", *map(str, classes), *(["err"] if errs else []), "right"], rows)
 
-    bands = [[_band(b["snr_db"]), f"{b['correct']}/{b['clips']} {_pct(b['accuracy'])}{_ci(b['ci95'])}",
-              f"{b['decided']}", _pct(b["accuracy_decided"])] for b in res["by_snr"]]
-    if bands:
-        print_table(f"Accuracy by measured SNR on {on} (green channel at the plot bins' block size)",
-                    ["measured SNR", "right", "decided", "accuracy of decided"], bands)
 
-    def figures(block: dict, ci: Any) -> list[str]:
-        return [str(block["scored"]), f"{block['correct']}/{block['scored']} {_pct(block['accuracy'], 1)}{_ci(ci)}",
-                f"{block['decided']} ({_pct(block['coverage'])})", _pct(block["accuracy_decided"], 1),
-                str(block["errors"])]
+def _bands(res: dict) -> None:
+    rows = [[BAND_NAMES.get(b["band"], b["band"]), str(b["clips"]), _of(b["correct"], b["clips"]), str(b["decided"]),
+             _of(b["correct_decided"], b["decided"])] for b in res["by_band"]]
+    labels = res["snr_source"] == "labels"
+    print_table(f"By SNR band, all {plural(sum(b['clips'] for b in res['by_band']), 'scored clip')} "
+                f"(SNR: {'labels.csv snr_db' if labels else 'measured'})",
+                ["band", "clips", "right", "decided", "right of decided"], rows)
+    lines = [] if labels else ["The labels give no snr_db: bands are on the measured SNR (see the SNR column)."]
+    if res.get("min_snr") is not None:
+        lines.append(f"--min-snr {res['min_snr']:g}: {plural(res['excluded'], 'clip')} under {res['min_snr']:g} dB "
+                     "left out of every figure")
+    print_lines(lines)
 
-    head = {"scored": res["scored"], "correct": res["correct"], "accuracy": res["accuracy"],
-            "decided": res["decided"], "coverage": res["coverage"], "accuracy_decided": res["accuracy_decided"],
-            "errors": sum(res["errors_by_class"])}
-    lines = [[on, *figures(head, res["ci95"])]]
+
+def _summary(res: dict, show_det: bool) -> None:
+    # one column per set of clips (narrow whatever the figures), one row per figure
+    head = {k: res[k] for k in ("scored", "correct", "accuracy", "ci95", "decided", "correct_decided")}
+    blocks = {res["scored_on"].split()[0]: dict(head, errors=sum(res["errors_by_class"]))}
     if show_det:
-        lines.append(["all clips", *figures(res["all"], res["all"]["ci95"])])
-    title = "Summary (accuracy: 95 % bootstrap interval over clips; decided: answers not undetermined)"
-    if res["skipped"]:
-        title += f"; {len(res['skipped'])} clips of more than one person skipped"
-    print_table(title, ["clips", "scored", "right", "decided", "right of decided", "errors"], lines)
+        blocks["all"] = res["all"]
+    figures = [
+        ("scored", lambda b: str(b["scored"])),
+        ("right", lambda b: f"{b['correct']} ({_pct(b['accuracy'], 1)})"),
+        ("95 % interval", lambda b: "-" if not b["ci95"] else f"{100 * b['ci95'][0]:.0f}-{100 * b['ci95'][1]:.0f} %"),
+        ("decided", lambda b: _of(b["decided"], b["scored"])),
+        ("right of decided", lambda b: _of(b["correct_decided"], b["decided"], 1)),
+        ("errors", lambda b: str(b["errors"])),
+    ]
+    print_table("Summary (95 % interval: bootstrap over clips; decided: answers not undetermined)",
+                ["clips", *blocks], [[name, *(f(b) for b in blocks.values())] for name, f in figures])
+    by_reason: dict[str, int] = {}
+    for s in res.get("skipped_reasons", []):
+        by_reason[s["reason"]] = by_reason.get(s["reason"], 0) + 1
+    print_lines([f"{plural(n, 'clip')} skipped: {why}" for why, n in by_reason.items()])
+
+
+def print_evaluation(res: dict) -> None:
+    # a detectable column only where it tells the rows apart
+    show_det = any(r["detectable"] is False for r in res["rows"])
+    _clips(res, show_det)
+    _confusion(res)
+    _bands(res)
+    _summary(res, show_det)

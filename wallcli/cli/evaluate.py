@@ -8,11 +8,13 @@ import typer
 
 from wallcli.cli.common import FORCE_HELP, MAX_THREADS, ROI_HELP, number_option
 
+PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
+
 
 def evaluate(
     folder: Path = typer.Argument(..., metavar="DIR", show_default=False,
                                   help="Folder of clips with labels.csv (columns file, people, activity; optional "
-                                       "detectable 0/1) or the .json sidecars 'wallcli simulate' writes."),
+                                       "detectable 0/1 and snr_db) or the .json sidecars 'wallcli simulate' writes."),
     task: str = typer.Option(..., "--task", "-t", help="count or activity."),
     model: Optional[Path] = typer.Option(None, "--model", help="Your own .onnx model (its .json card beside it). "
                                          "Default: the shipped model for --task."),
@@ -22,6 +24,9 @@ def evaluate(
                                         "SNR to this PNG."),
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
                               help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
+    min_snr: Optional[float] = number_option(None, "--min-snr", lo=-99, hi=99, help="Score only empty rooms and "
+                                             "clips whose SNR in dB (labels.csv's snr_db, else the measured one) is "
+                                             "at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=FORCE_HELP),
 ) -> None:
@@ -29,25 +34,29 @@ def evaluate(
 
     Each clip is decoded once, classified exactly as 'wallcli count' / 'activity' would
     (same model, windows and stride) and its SNR measured (green channel, wallcli snr's
-    estimator at the block size of one space-time plot bin). Prints one row per clip,
-    accuracy with a 95 % bootstrap interval over clips, the confusion matrix, accuracy by
-    measured SNR and per class, and how many answers were decided (not 'undetermined') and
-    how often those were right. With a 'detectable' column, the headline figures are on
-    detectable clips and the same on all clips follow. For activity, clips with more than
-    one person are skipped. A clip that cannot be analysed (missing, corrupt, too short) is
-    a row with its error and counts as wrong.
+    estimator at the block size of one space-time plot bin). Prints one row per clip
+    (long reasons as footnotes), the confusion matrix with accuracy per class, clips right
+    by SNR band (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db
+    column where there is one, else on the measured SNR), accuracy with a 95 % bootstrap
+    interval over clips, and how many answers were decided (not 'undetermined') and how
+    often those were right. With a 'detectable' column, the headline figures are on
+    detectable clips and the same on all clips follow; the bands count every clip. For
+    activity, clips with more than one person are skipped; so is a clip whose sidecar is
+    damaged, with a warning. A clip that cannot be analysed (missing, corrupt, too short)
+    is a row with its error and counts as wrong.
 
     \b
-    labels.csv (other columns are ignored):
-      file,people,activity,detectable
-      kitchen-01.mp4,1,walking,1
-      kitchen-02.mp4,0,none,1
+    labels.csv (other columns are ignored; snr_db is empty for an empty room):
+      file,people,activity,detectable,snr_db
+      kitchen-01.mp4,1,walking,1,12.5
+      kitchen-02.mp4,0,none,1,
 
     \b
     Examples:
       wallcli evaluate recordings/ --task count
       wallcli evaluate recordings/ --task activity --json | jq '.accuracy, .ci95'
       wallcli evaluate recordings/ --task count --model new.onnx --plot reliability.png --jobs 4
+      wallcli evaluate recordings/ --task count --min-snr 0 --json | jq '.by_band'
     """
     from wallcli.errors import UsageError
 
@@ -57,16 +66,18 @@ def evaluate(
 
     roi_t = parse_roi(roi)
 
-    from wallcli.cli.output import emit_json, progress
+    from wallcli.cli.output import emit_json, progress, warn
     from wallcli.evaluate import evaluate_folder
-    from wallcli.evaluate.labels import read_labels
+    from wallcli.evaluate.run import plan_folder
     from wallcli.io.writer import check_outputs
 
-    clips, _ = read_labels(folder)  # fails early (exit 1) on a folder without labels
-    check_outputs([plot], force=force, inputs=[model, *(c.path for c in clips)])
-    total = sum(task == "count" or c.persons <= 1 for c in clips)  # activity skips clips of two people
-    with progress(f"evaluate {task}", total) as advance:
-        result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance)
+    plan = plan_folder(folder, task, min_snr=min_snr)  # fails early (exit 1) on a folder without labels
+    for file, why in plan.labels.damaged:
+        warn(f"{file} skipped: {why}")
+    check_outputs([plot], force=force, inputs=[model, *(c.path for c in plan.labels.clips)])
+    # delayed: on a small folder a bar would only flash; on a large one it shows the minutes left
+    with progress(f"evaluate {task}", len(plan.kept), delay=PROGRESS_DELAY) as advance:
+        result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan)
     if plot is not None:
         from wallcli.plots.reliability import save_reliability_png
 

@@ -69,7 +69,8 @@ def warn(message: str) -> None:
     console_err.print(Text.assemble(("Warning:", "yellow"), " ", printable(message)))
 
 
-def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
+def print_table(title: str, columns: list[str], rows: list[list[Any]], *, pad_edge: bool = True) -> None:
+    """``pad_edge=False``: no blank inside the outer borders, two columns more for a wide table."""
     from rich.table import Table
 
     from rich.text import Text
@@ -77,12 +78,25 @@ def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
     # the title is its own unwrapped line: scripts grep it ("count = 1") and a long path must
     # not split it across lines, as a table title wrapped to the table's width would
     console_out.print(Text(printable(title)), soft_wrap=True)
-    table = Table()
+    table = Table(pad_edge=pad_edge)
     for i, col in enumerate(columns):
         table.add_column(printable(col), justify="left" if i == 0 else "right")
     for row in rows:
         table.add_row(*(printable(c) for c in row))
     console_out.print(table)
+
+
+def print_lines(lines: list[str], *, hang: int = 0) -> None:
+    """Lines of text on stdout (notes and footnotes under a table), wrapped to the terminal's width;
+    ``hang``: indent of a wrapped line's continuation (under the text of a footnote, not its number)."""
+    import textwrap
+
+    for line in lines:
+        text = printable(line)
+        if hang:
+            text = textwrap.fill(text, max(console_out.width, 2 * hang), subsequent_indent=" " * hang,
+                                 break_long_words=False, break_on_hyphens=False)
+        console_out.print(text)
 
 
 # --------------------------------------------------------------------------------------- stdout
@@ -157,11 +171,23 @@ def abandon_stdout() -> None:
 
 
 @contextmanager
-def progress(description: str, total: int | None, *, enabled: bool = True) -> Iterator[Any]:
-    """A rich progress bar on stderr; yields ``advance(n=1)``. Silent when stderr is not a terminal."""
+def progress(description: str, total: int | None, *, enabled: bool = True, delay: float = 0.0) -> Iterator[Any]:
+    """A rich progress bar on stderr; yields ``advance(n=1)``. Silent when stderr is not a terminal.
+    ``delay``: seconds before it appears, so that work shorter than that shows none."""
     if not enabled or not console_err.is_terminal:
         yield lambda n=1: None
         return
+    if delay > 0:
+        with _delayed(description, total, delay) as advance:
+            yield advance
+        return
+    with _bar(description, total) as (bar, task):
+        bar.start()
+        yield lambda n=1: bar.advance(task, n)
+
+
+@contextmanager
+def _bar(description: str, total: int | None) -> Iterator[Any]:
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -174,9 +200,37 @@ def progress(description: str, total: int | None, *, enabled: bool = True) -> It
     cols = [TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn()]
     if total:
         cols.append(TimeRemainingColumn())
-    with Progress(*cols, console=console_err, transient=True) as bar:
-        task = bar.add_task(description, total=total)
-        yield lambda n=1: bar.advance(task, n)
+    bar = Progress(*cols, console=console_err, transient=True)
+    try:
+        yield bar, bar.add_task(description, total=total)
+    finally:
+        if bar.live.is_started:  # stop() of a bar never shown would still print a blank line on some terminals
+            bar.stop()
+
+
+@contextmanager
+def _delayed(description: str, total: int | None, delay: float) -> Iterator[Any]:
+    """The bar started by a timer: the work may not advance it for a long while (a first clip)."""
+    import threading
+
+    with _bar(description, total) as (bar, task):
+        lock = threading.Lock()
+        done = False
+
+        def show() -> None:
+            with lock:
+                if not done:
+                    bar.start()
+
+        timer = threading.Timer(delay, show)
+        timer.daemon = True
+        timer.start()
+        try:
+            yield lambda n=1: bar.advance(task, n)
+        finally:
+            with lock:  # after this, show() cannot start a bar that _bar has already stopped
+                done = True
+                timer.cancel()
 
 
 @contextmanager

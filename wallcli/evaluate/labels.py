@@ -2,17 +2,22 @@
 
 ``labels.csv`` needs the columns ``file``, ``people`` and ``activity`` (``people`` counts the
 people who *move*: someone standing still is 0, as ``wallcli count`` counts); ``detectable`` (0/1)
-is optional and every other column is ignored. A sidecar's ``people`` counts everyone in the room,
-so a count's truth there is the number of its ``activities`` other than ``none`` (what
-tests/test_examples.py checks the shipped models against). Labels that cannot be read are a
-failure of the whole run (exit 1, naming the line); a clip that is missing is not: it becomes
-that clip's error row.
+and ``snr_db`` (the known SNR; empty for an empty room) are optional and every other column is
+ignored. A sidecar's ``people`` counts everyone in the room, so a count's truth there is the number
+of its ``activities`` other than ``none`` (what tests/test_examples.py checks the shipped models
+against). A labels.csv that cannot be read is a failure of the whole run (exit 1, naming the line);
+a clip that is missing is not: it becomes that clip's error row. A sidecar is one clip's labels, so
+a damaged one (beside its video) skips that clip, with the reason, rather than failing the run.
+Two names for one file (``a.mp4``, ``./a.mp4``) are one clip listed twice: an error, as any
+duplicate is, since scoring it twice would weigh it double.
 """
 from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass
+import math
+import os
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -30,28 +35,54 @@ class Clip:
     activity: str
     detectable: bool | None  # None: not given
     persons: int  # everyone in the room, still or not: activity is defined for at most one
+    snr_db: float | None = None  # the labels' SNR; None for an empty room or without the column
 
     def truth(self, task: str) -> Any:
         return self.people if task == "count" else self.activity
 
+    def empty(self, task: str) -> bool:
+        """An empty room: nobody moves (and, for activity, the label says so)."""
+        return self.people == 0 and (task == "count" or self.activity == "none")
 
-def read_labels(folder: str | Path) -> tuple[list[Clip], str]:
-    """(clips in the labels' order, where the labels came from: 'labels.csv' or 'sidecars')."""
+
+@dataclass(frozen=True)
+class Labels:
+    clips: list[Clip]  # in the labels' order
+    source: str  # 'labels.csv' or 'sidecars'
+    has_snr: bool  # the labels give each clip's SNR (an snr_db column)
+    damaged: list[tuple[str, str]] = field(default_factory=list)  # (clip, why its sidecar cannot be used)
+
+
+def read_labels(folder: str | Path) -> Labels:
     d = Path(folder)
     if not d.exists():
         raise WallcliError(f"no such folder: {folder}")
     if not d.is_dir():
         raise WallcliError(f"{folder} is not a folder; give the folder that holds the clips and their labels")
     if (d / LABELS).is_file():
-        return _from_csv(d), LABELS
-    clips = _from_sidecars(d)
+        clips, has_snr = _from_csv(d)
+        return Labels(clips, LABELS, has_snr)
+    clips, damaged = _from_sidecars(d)
     if not clips:
+        why = f" ({len(damaged)} damaged: {damaged[0][1]})" if damaged else ""
         raise WallcliError(f"{folder} has no labels: looked for {LABELS} (columns {', '.join(REQUIRED)}) and for "
-                           "*.json sidecars with 'people' and 'activity' (as 'wallcli simulate' writes them)")
-    return clips, "sidecars"
+                           f"*.json sidecars with 'people' and 'activity' (as 'wallcli simulate' writes them){why}")
+    return Labels(clips, "sidecars", False, damaged)
 
 
-def _from_csv(d: Path) -> list[Clip]:
+def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
+    """Fail on two entries that name one file, however spelled (``a.mp4``, ``./a.mp4``, its full path)."""
+    seen: dict[str, tuple[str, Clip]] = {}
+    for where, c in named:
+        key = os.path.normcase(os.path.normpath(os.path.abspath(c.path)))
+        if key in seen:
+            first, other = seen[key]
+            raise WallcliError(f"{source} names one clip twice: {first} ({other.file!r}) and {where} ({c.file!r}); "
+                               "list each clip once")
+        seen[key] = (where, c)
+
+
+def _from_csv(d: Path) -> tuple[list[Clip], bool]:
     path = d / LABELS
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
@@ -62,21 +93,18 @@ def _from_csv(d: Path) -> list[Clip]:
                 raise WallcliError(f"{path} lacks the column(s) {', '.join(missing)} (needs {', '.join(REQUIRED)}; "
                                    f"has {', '.join(header) or 'none'})")
             reader.fieldnames = header
-            clips = [_csv_row(path, n, row) for n, row in enumerate(reader, start=2)
+            has_snr = "snr_db" in header
+            named = [(f"line {n}", _csv_row(path, n, row, has_snr)) for n, row in enumerate(reader, start=2)
                      if any((v or "").strip() for v in row.values() if isinstance(v, str))]
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise WallcliError(f"cannot read {path}: {exc}") from None
-    if not clips:
+    if not named:
         raise WallcliError(f"{path} lists no clips")
-    seen: set[str] = set()
-    for c in clips:
-        if c.file in seen:
-            raise WallcliError(f"{path} lists {c.file} twice")
-        seen.add(c.file)
-    return clips
+    _no_duplicates(path, named)
+    return [c for _, c in named], has_snr
 
 
-def _csv_row(path: Path, line: int, row: dict) -> Clip:
+def _csv_row(path: Path, line: int, row: dict, has_snr: bool) -> Clip:
     where = f"{path} line {line}"
     name = (row.get("file") or "").strip()
     if not name:
@@ -88,7 +116,25 @@ def _csv_row(path: Path, line: int, row: dict) -> Clip:
     det = (row.get("detectable") or "").strip()
     if det not in ("", "0", "1"):
         raise WallcliError(f"{where}: 'detectable' must be 0 or 1 (got {det!r})")
-    return Clip(name, path.parent / name, people, activity, None if det == "" else det == "1", people)
+    snr = _snr(row.get("snr_db"), people, where) if has_snr else None
+    return Clip(name, path.parent / name, people, activity, None if det == "" else det == "1", people, snr)
+
+
+def _snr(value: Any, people: int, where: str) -> float | None:
+    text = (value or "").strip()
+    if not text:
+        if people:  # the band table would have to guess, so say so now
+            raise WallcliError(f"{where}: empty 'snr_db' where people = {people} (an empty cell "
+                               "means an empty room; give its SNR, or drop the column to use the measured SNR)")
+        return None
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not math.isfinite(x):
+        raise WallcliError(f"{where}: 'snr_db' must be a number of dB (got {text!r})")
+    return x
+
 
 
 def _people(value: Any, where: str) -> int:
@@ -101,28 +147,43 @@ def _people(value: Any, where: str) -> int:
     return n
 
 
-def _from_sidecars(d: Path) -> list[Clip]:
-    clips = []
+def _from_sidecars(d: Path) -> tuple[list[Clip], list[tuple[str, str]]]:
+    """(clips, damaged). A .json that cannot be read or lacks a label is a damaged sidecar when a
+    video shares its name; without one it is some other file (a report, another tool's output)."""
+    named, damaged = [], []
     for side in sorted(d.glob("*.json")):
+        beside = [p for p in sorted(d.glob(side.stem + ".*")) if p.suffix.lower() != ".json"]
         try:
-            meta = json.loads(side.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-            continue  # not a sidecar (another tool's output, a report): not ours to judge
-        if not isinstance(meta, dict) or "people" not in meta or "activity" not in meta:
+            named.append((side.name, _sidecar(d, side, beside)))
+        except LookupError:
             continue
-        where = str(side)
-        acts = meta.get("activities")
-        if isinstance(acts, list) and all(isinstance(a, str) for a in acts):
-            moving = sum(a != "none" for a in acts)  # a still person is not counted (count's task)
-        else:
-            moving = _people(meta["people"], where)
-        video = meta.get("video")
-        if isinstance(video, str) and video and (d / Path(video).name).exists():
-            target = d / Path(video).name
-        else:  # the video beside it: same name, any other extension
-            found = [p for p in sorted(d.glob(side.stem + ".*")) if p.suffix.lower() != ".json"]
-            target = found[0] if found else d / (side.stem + ".mp4")
-        det = meta.get("detectable")
-        clips.append(Clip(target.name, target, moving, str(meta["activity"]).strip(),
-                          None if det is None else bool(det), _people(meta["people"], where)))
-    return clips
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError, WallcliError) as exc:
+            if beside:
+                why = str(exc) if isinstance(exc, WallcliError) else f"{side.name}: {exc}"
+                damaged.append((beside[0].name, "damaged sidecar: " + " ".join(why.split())))
+    _no_duplicates(d, named)
+    return [c for _, c in named], damaged
+
+
+def _sidecar(d: Path, side: Path, beside: list[Path]) -> Clip:
+    """The clip a sidecar labels; LookupError: not a sidecar at all."""
+    meta = json.loads(side.read_text(encoding="utf-8"))
+    keys = [k for k in ("people", "activity") if isinstance(meta, dict) and k in meta]
+    if not keys:
+        raise LookupError(side.name)
+    if len(keys) == 1:
+        raise WallcliError(f"{side.name} has {keys[0]!r} but not {({'people', 'activity'} - set(keys)).pop()!r}")
+    where = side.name
+    acts = meta.get("activities")
+    if isinstance(acts, list) and all(isinstance(a, str) for a in acts):
+        moving = sum(a != "none" for a in acts)  # a still person is not counted (count's task)
+    else:
+        moving = _people(meta["people"], where)
+    video = meta.get("video")
+    if isinstance(video, str) and video and (d / Path(video).name).exists():
+        target = d / Path(video).name
+    else:  # the video beside it: same name, any other extension
+        target = beside[0] if beside else d / (side.stem + ".mp4")
+    det = meta.get("detectable")
+    return Clip(target.name, target, moving, str(meta["activity"]).strip(),
+                None if det is None else bool(det), _people(meta["people"], where))

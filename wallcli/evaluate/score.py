@@ -20,6 +20,10 @@ SEED = 0
 Z95 = 1.959963984540054
 # measured SNR bands (dB): edges between them
 SNR_EDGES = (-5.0, 0.0, 5.0, 10.0)
+# CONTRACT.md's by_band: (name, [lo, hi) in dB). Under 0 dB a person is hard to tell from an empty
+# room; from 10 dB up plain to see in a space-time plot (the transfer set's README).
+BANDS = (("empty", None, None), ("<0 dB", None, 0), ("0-10 dB", 0, 10), (">=10 dB", 10, None))
+UNMEASURED = "not measured"
 CONFIDENCE_BINS = 10
 
 
@@ -80,6 +84,7 @@ def summary(rows: list[dict], classes: list) -> dict[str, Any]:
         "decided": len(dec),
         "coverage": _ratio(len(dec), len(rows)),
         "accuracy_decided": _ratio(right_decided, len(dec)),
+        "correct_decided": right_decided,
         "ci95_decided": wilson_ci(right_decided, len(dec)),
         "confusion": confusion,
         "errors_by_class": errors_by_class,
@@ -109,6 +114,29 @@ def by_snr(rows: list[dict], edges=SNR_EDGES) -> list[dict]:
     rest = [r for r in rows if r.get("snr_db") is None]
     if rest:
         out.append({"snr_db": None, **_group(rest)})
+    return out
+
+
+def band_of(empty: bool, snr_db: float | None) -> str:
+    """The by_band name of a clip: empty rooms by their truth, the others by SNR."""
+    if empty:
+        return "empty"
+    if snr_db is None:
+        return UNMEASURED
+    return next(name for name, lo, hi in BANDS[1:] if (lo is None or snr_db >= lo) and (hi is None or snr_db < hi))
+
+
+def by_band(rows: list[dict]) -> list[dict]:
+    """Clips, right, decided and decided-and-right per band of ``row['band']``: always the four
+    bands, then one for clips whose SNR is unknown (failed or a plot file, measured SNR) if any."""
+    out = []
+    for name, lo, hi in (*BANDS, (UNMEASURED, None, None)):
+        sel = [r for r in rows if r["band"] == name]
+        if name == UNMEASURED and not sel:
+            continue
+        dec = [r for r in sel if decided(r)]
+        out.append({"snr_db": None if name == UNMEASURED else [lo, hi], "band": name, "clips": len(sel),
+                    "correct": sum(map(correct, sel)), "decided": len(dec), "correct_decided": sum(map(correct, dec))})
     return out
 
 
