@@ -1,4 +1,4 @@
-"""Small `wallcli scan` results (CONTRACT.md: one JSON object per video and line), written by hand:
+"""Small `wallcli scan` results (docs/contract.md: one JSON object per video and line), written by hand:
 answers decided and undetermined, results from before the confident flag, a failed video, a
 hostile file name and a last line cut short by a killed scan."""
 from __future__ import annotations

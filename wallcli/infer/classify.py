@@ -49,7 +49,7 @@ def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
 
 
 def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict[str, Any]:
-    """The CONTRACT.md result from window start times, their probabilities (n, classes) and
+    """The docs/contract.md result from window start times, their probabilities (n, classes) and
     measured signals (n,) in dB."""
     clip = probs.mean(axis=0)
     clip = clip / clip.sum()
@@ -73,7 +73,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict
 
 
 def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
-    """The CONTRACT.md result for a whole space-time plot (a .npz file, already in memory)."""
+    """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
     plots, grid = resampled_plots(model, plot)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
@@ -128,7 +128,7 @@ class WindowClassifier:
             self._emitted = self.windower.count
 
     def result(self, source: str) -> dict[str, Any]:
-        """The CONTRACT.md result; WallcliError when the stream was shorter than one window."""
+        """The docs/contract.md result; WallcliError when the stream was shorter than one window."""
         model, w = self.model, self.windower
         last = w.last()
         if last is None:

@@ -34,7 +34,7 @@ class ClipAnalysis:
     grid: Any  # wallcli.signal.snr.GridAccumulator
     frame: np.ndarray  # the first decoded frame, RGB float32 0-255
     models: dict[str, Any]  # task -> wallcli.infer.model.Model
-    results: dict[str, dict] = field(default_factory=dict)  # task -> CONTRACT.md result
+    results: dict[str, dict] = field(default_factory=dict)  # task -> docs/contract.md result
     failures: dict[str, str] = field(default_factory=dict)  # task -> why it has no verdict
     warnings: list[str] = field(default_factory=list)
 

@@ -1,4 +1,4 @@
-"""The summary of a ``wallcli scan`` run: its JSON Lines (CONTRACT.md), one row per video.
+"""The summary of a ``wallcli scan`` run: its JSON Lines (docs/contract.md), one row per video.
 
 A scan writes and flushes one line per video as it finishes, so a killed scan leaves a file
 whose last line may be cut short; a line that is not a JSON object becomes a row carrying that

@@ -1,6 +1,6 @@
 """Clip and window answers as a page states them: the label, or ``undetermined (reason)``.
 
-``confident`` and ``reason`` (CONTRACT.md) are read with ``.get``: results written before they
+``confident`` and ``reason`` (docs/contract.md) are read with ``.get``: results written before they
 existed carry neither, and then the answer is shown as it is, with its confidence unknown.
 """
 from __future__ import annotations

@@ -341,7 +341,7 @@ class FrameSnr:
 
 
 def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, notes=()) -> dict:
-    """The object of ``wallcli snr --json`` (CONTRACT.md) from a fed accumulator.
+    """The object of ``wallcli snr --json`` (docs/contract.md) from a fed accumulator.
 
     One builder for ``wallcli snr`` and ``wallcli scan`` (which feeds the accumulator from the
     decode that also makes the space-time plots), so both report the same fields.  ``notes``:
