@@ -10,19 +10,19 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
                            help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
-JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see CONTRACT.md).")
+JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see docs/contract.md).")
 PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
                         "(for a video, the plot drawn is averaged down to at most 2048 time columns).")
 MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
 THREADS_OPT = threads_option("onnxruntime intra-op threads (0: onnxruntime chooses).")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
-FORCE_OPT = typer.Option(False, "--force", help="Overwrite the --plot file.")
+FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
 INPUT_ARG = input_argument(INPUT_HELP)
 
 

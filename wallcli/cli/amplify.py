@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # Frames held back while the automatic gain calibrates are kept whole only with --side-by-side
@@ -56,7 +56,7 @@ def amplify(
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),
     preset: str = typer.Option("superfast", "--preset", help="x264 speed preset, ultrafast ... veryslow. superfast: 2x faster than veryfast, same size here; ultrafast: 2x faster again, 2x bigger."),
     json_out: bool = typer.Option(False, "--json", help="Print a summary (gain, frames, fps, size) as JSON on stdout."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("OUTPUT")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Make the invisible visible: a video of the wall's tiny light changes, amplified.

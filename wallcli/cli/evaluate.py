@@ -6,7 +6,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, MAX_THREADS, ROI_HELP, number_option
+from wallcli.cli.common import MAX_THREADS, ROI_HELP, force_help, number_option
 
 
 def evaluate(
@@ -16,14 +16,14 @@ def evaluate(
     task: str = typer.Option(..., "--task", "-t", help="count or activity."),
     model: Optional[Path] = typer.Option(None, "--model", help="Your own .onnx model (its .json card beside it). "
                                          "Default: the shipped model for --task."),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (CONTRACT.md), rows included."),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (docs/contract.md), rows included."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw a reliability diagram (confidence of the clip "
                                         "answers against how often they are right) and accuracy against measured "
                                         "SNR to this PNG."),
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
                               help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG, the only file evaluate writes,")),
 ) -> None:
     """Score a model on labelled clips: the check to run before relying on it for a room.
 

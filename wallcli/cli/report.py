@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, parse_roi, threads_option
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
 
@@ -19,7 +19,7 @@ def report(
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
     count_model: Optional[Path] = typer.Option(None, "--count-model", help="Your own count .onnx (its card beside it). Default: the shipped model."),
     activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Write one HTML page that opens offline in any browser and can be handed over as it is.

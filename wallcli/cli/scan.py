@@ -14,7 +14,7 @@ def scan(
     inputs: List[str] = typer.Argument(..., help="Video files, folders (searched recursively, see --glob), http(s)/rtsp "
                                        "URLs, or @list.txt (one path or URL a line, # comments).", show_default=False,
                                        metavar="INPUT"),
-    output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see CONTRACT.md), "
+    output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see docs/contract.md), "
                                 "or flattened CSV when the name ends in .csv. An existing file is resumed.",
                                 show_default=False),
     task: str = typer.Option("count,activity,snr", "--task", help="Comma list of count, activity, snr: what each video is "

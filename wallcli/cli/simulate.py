@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, MAX_THREADS, number_option
+from wallcli.cli.common import MAX_THREADS, force_help, number_option
 
 ACTS = ("none", "walking", "crouching", "waving", "jumping")
 
@@ -85,7 +85,8 @@ def simulate(
                                            "video's space-time plots (PNG)."),
     json_out: bool = typer.Option(False, "--json", help="Print the ground truth (without per-frame positions) as JSON on stdout; "
                                   "with --dataset, a summary with the measured windows/s."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP + " With --dataset: rebuild every shard."),
+    force: bool = typer.Option(False, "--force", help=force_help("OUTPUT, its .json ground truth and the --preview file")
+                       + " With --dataset: rebuild every shard."),
     dataset: Optional[int] = number_option(None, "--dataset", lo=1, hi=10_000_000, integer=True, help="Dataset mode: write N labelled 256-frame windows "
                                           "(shards of .npz + dataset.json) to the -o folder instead of one video."),
     task: str = typer.Option("count", "--task", help="Dataset labels: count (0/1/2 people, every activity, mixed pairs) or "

@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, THREADS_HELP, Number, number_option, threads_option
+from wallcli.cli.common import THREADS_HELP, Number, force_help, number_option, threads_option
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
 # checks the option and every value of a --sweep alike.
@@ -42,11 +42,11 @@ def _predict_option(name: str):
 
 def snr(
     input: Optional[str] = typer.Argument(None, help="Video file, http(s)/rtsp URL, or '-' (not needed with --predict).", show_default=False),
-    roi: Optional[str] = typer.Option(None, "--roi", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
+    roi: Optional[str] = typer.Option(None, "--roi", metavar="X,Y,W,H|auto", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
                                       "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
                                       "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
                                       "covariances). 'auto' reads the file twice. Default: whole frame."),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object (CONTRACT.md fields, plus extras) on stdout."),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object (docs/contract.md fields, plus extras) on stdout."),
     heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
@@ -72,7 +72,7 @@ def snr(
     bits: int = _predict_option("bits"),
     pixels: float = _predict_option("pixels"),
     frames: float = _predict_option("frames"),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Measure the wall signal and the noise in a video (seed §4), per colour channel.

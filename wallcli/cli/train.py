@@ -7,7 +7,7 @@ from typing import List, Optional
 
 import typer
 
-from wallcli.cli.common import number_option, threads_option
+from wallcli.cli.common import force_help, number_option, threads_option
 
 INSTALL_HINT = "pip install torch==2.13.0 && pip install 'wallcli[train]'"
 
@@ -75,7 +75,7 @@ def train(
                              "--anneal ends at 1/100 of it). Lower it to fine-tune from --init."),
     device: str = typer.Option("cpu", "--device", help="Where the net trains: 'cpu', or 'cuda' on a machine with an "
                                "NVIDIA GPU and a CUDA build of PyTorch (batches are still read and augmented on the CPU)."),
-    force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
+    force: bool = typer.Option(False, "--force", help=force_help("OUT and its card")),
 ) -> None:
     """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
 
