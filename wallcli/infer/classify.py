@@ -31,10 +31,12 @@ def _too_short(source: str, frames: int, model) -> WallcliError:
 
 def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> dict[str, Any]:
     k = int(np.argmax(probs))
+    # judged on the figure the JSON carries, so that the reason quotes exactly that figure
+    signal_db = round(float(signal_db), 2)
     confident, reason = judge(model.card.get("confidence"), probs, signal_db, model.classes)
     return {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
             "label": model.classes[k], "probabilities": [float(p) for p in probs],
-            "confident": confident, "reason": reason, "signal_db": round(float(signal_db), 2)}
+            "confident": confident, "reason": reason, "signal_db": signal_db}
 
 
 def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
@@ -53,7 +55,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict
     measured signals (n,) in dB."""
     clip = probs.mean(axis=0)
     clip = clip / clip.sum()
-    clip_db = float(np.mean(signal_db))
+    clip_db = round(float(np.mean(signal_db)), 2)
     confident, reason = judge(model.card.get("confidence"), clip, clip_db, model.classes)
     return {
         "input": source,
@@ -65,7 +67,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict
         "probabilities": [float(p) for p in clip],
         "confident": confident,
         "reason": reason,
-        "signal_db": round(clip_db, 2),
+        "signal_db": clip_db,
         "stride": int(stride),
         "window": model.window,
         "windows": [_window_record(model, t, pr, db) for t, pr, db in zip(times, probs, signal_db)],

@@ -9,9 +9,9 @@ from typing import Any
 
 
 def label_text(task: str | None, label: Any) -> str:
-    if task == "count" and isinstance(label, int) and not isinstance(label, bool):
-        return f"{label} {'person' if label == 1 else 'people'}"
-    return str(label)
+    from wallcli.wording import label_text as words
+
+    return words(label) if task == "count" else str(label)
 
 
 def answer(task: str | None, obj: Any) -> dict[str, Any]:
