@@ -65,10 +65,13 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
                                         progress=advance, keep_plot=plot is not None)
     with committed_together():  # the figure and the data on stdout: all or none
         _report(task, input, model, result, st, plot, json_out, force)
+    from wallcli.cli.output import wrote
+
+    wrote((plot, "class probabilities over time above the horizontal space-time plot"))
 
 
 def _report(task, input, model, result, st, plot, json_out, force) -> None:
-    from wallcli.cli.output import emit_json, print_table
+    from wallcli.cli.output import emit_json, print_lines, print_table
 
     if plot is not None:
         from wallcli.plots.timeline import save_timeline_png
@@ -78,20 +81,26 @@ def _report(task, input, model, result, st, plot, json_out, force) -> None:
         emit_json(result)
         return
     # one row per window (each lasts window/fps seconds from its start) and the clip's answer;
-    # no 'end' column so that five classes fit an 80-column terminal
-    classes = result["classes"]
+    # no 'end' column, and reasons under the table, so that five classes fit 80 columns
+    from wallcli.wording import answer_text, format_db, label_text
 
     def shown(r):  # an answer that may not be relied upon is not shown as one
         return str(r["label"]) if r.get("confident", True) else "undetermined"
 
-    rows = [[f"{w['start']:.2f}", shown(w), f"{w.get('signal_db', float('nan')):.0f}", *(f"{p:.3f}" for p in w["probabilities"])]
-            for w in result["windows"]]
-    rows.append(["clip", shown(result), f"{result.get('signal_db', float('nan')):.0f}", *(f"{p:.3f}" for p in result["probabilities"])])
+    def row(first, r):
+        return [first, shown(r), format_db(r.get("signal_db")), *(f"{p:.3f}" for p in r["probabilities"])]
+
+    rows = [row(f"{w['start']:.2f}", w) for w in result["windows"]] + [row("clip", result)]
     span = result["window"] / result["fps"]
-    answer = (f"{result['label']} (p={max(result['probabilities']):.2f}" if result.get("confident", True)
-              else f"undetermined ({result.get('reason')}; most likely {result['label']}, p={max(result['probabilities']):.2f}")
-    print_table(f"{input}: {task} = {answer}; {len(result['windows'])} windows of {span:.2f} s)",
-                ["start (s)", "answer", "signal dB", *(f"{c} people" if isinstance(c, int) else str(c) for c in classes)], rows)
+    n = len(result["windows"])
+    print_table(f"{input}: {task} = {answer_text(result)}; {n} window{'' if n == 1 else 's'} of {span:.2f} s",
+                ["start (s)", "answer", "signal dB", *map(label_text, result["classes"])], rows)
+    notes = []
+    if not result.get("confident", True):
+        notes.append(f"undetermined: {result.get('reason') or 'no reason given'}.")
+    if any(not w.get("confident", True) for w in result["windows"]):
+        notes.append("Each window's reason: --json (windows[].reason).")
+    print_lines(notes)
     note = accuracy_note(model.card)
     if note:
         from wallcli.cli.output import log

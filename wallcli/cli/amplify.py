@@ -96,7 +96,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
 
     import numpy as np
 
-    from wallcli.cli.output import console_err, emit_json, progress
+    from wallcli.cli.output import emit_json, progress, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import VideoWriter, atomic_path
@@ -151,7 +151,8 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds, "smooth": smooth,
         "gain": amp.gain, "gain_mode": "auto" if amp.auto_gain else "fixed", "sigma": amp.sigma,
     }
-    console_err.print(f"amplify: {frames} frames -> {output} ({out_w}x{ph}, gain {amp.gain:.4g} "
-                      f"{'auto' if amp.auto_gain else 'given'}, grid {cols}x{rows})", highlight=False)
+    # the grid in the order of the JSON's "grid": [rows, cols]
+    wrote((output, f"{frames} frames of {out_w}x{ph} pixels; gain {amp.gain:.4g} "
+                   f"({'automatic' if amp.auto_gain else 'given'}); the wall averaged in {rows} rows x {cols} columns of blocks"))
     if json_out:
         emit_json(summary)

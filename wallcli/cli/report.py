@@ -79,6 +79,12 @@ def report(
             warn(f"no {task} verdict: {why}")
         html = clip_page(analysis, command=command)
     write_text_atomic(output, html, force=force)
+    from wallcli.cli.output import wrote
+
+    size = len(html.encode("utf-8"))
+    what = "scan summary" if results else "report"
+    shown = f"{size / 1e6:.1f} MB" if size >= 1e6 else f"{max(size / 1e3, 1):.0f} kB"
+    wrote((output, f"{what}, {shown}, self-contained: open it in any browser"))
 
 
 def _command_line(input, output, roi, count_model, activity_model, force, threads) -> str:

@@ -204,6 +204,12 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
         tmp_truth.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
         _finish(output, tmp_video, sidecar, truth, preview, json_out, force)
+    from wallcli.cli.output import wrote
+    from wallcli.wording import label_text
+
+    who = label_text(truth["people"]) + (f", {truth['activity']}" if truth["people"] else "")
+    wrote((output, f"{n} frames at {fps:g} fps, {w}x{h} pixels, {who}, seed {seed}"), (sidecar, "its ground truth"),
+          (preview, "the room from above beside the space-time plots"))
 
 
 def _finish(output, tmp_video, sidecar, truth, preview, json_out, force) -> None:

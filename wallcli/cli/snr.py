@@ -115,12 +115,13 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     import warnings
 
     from wallcli.cli.common import parse_roi
-    from wallcli.cli.output import emit_json, print_table, progress, warn
+    from wallcli.cli.output import emit_json, print_table, progress, warn, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.snr import GridAccumulator, SnrAccumulator, snr_db, snr_report
+    from wallcli.wording import format_db
 
     auto = roi is not None and roi.strip().lower() == "auto"
     roi_t = None if auto else parse_roi(roi)
@@ -169,6 +170,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         from wallcli.plots.snr import save_scales_png
 
         save_scales_png(plot, result, force=force)
+    wrote((heatmap, f"{heatmap_of} per cell of the wall"), (plot, "SNR and noise against block size"))
     if json_out:
         emit_json(result)
         return
@@ -178,14 +180,17 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
         "powers in 8-bit code values^2",
-        ["block", "signal R / G / B", "noise R / G / B", "SNR dB R / G / B"],
+        ["block", "signal R G B", "noise R G B", "block SNR dB R G B"],
         [[f"{s['block']}x{s['block']}", _triple(s["signal_power"]), _triple(s["noise_power"]),
-          _triple(s["snr_db"], "{:.1f}")] for s in result["scales"]],
+          _triple(s["snr_db"], format_db, 5)] for s in result["scales"]],
     )
 
 
-def _triple(v, fmt: str = "{:.4g}") -> str:
-    return " / ".join("-" if x is None or x != x else fmt.format(x) for x in v)
+def _triple(v, fmt=None, width: int = 7) -> str:
+    # three significant digits in fixed-width fields keep three channels of three quantities in
+    # aligned columns within 80 characters; the JSON has every digit
+    fmt = fmt or (lambda x: "-" if x is None or x != x else f"{x:.3g}")
+    return " ".join(fmt(x).rjust(width) for x in v)
 
 
 # ------------------------------------------------------------------------------------- predict
@@ -265,6 +270,9 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
         from wallcli.plots.snr import save_sweep_png
 
         save_sweep_png(plot, key, rows, force=force)
+        from wallcli.cli.output import wrote
+
+        wrote((plot, f"predicted SNR against {key.replace('_', '-')}"))
     if json_out:
         emit_json({"mode": "predict", "parameters": settings, "sweep": {"parameter": key.replace("_", "-"), "values": values},
                    "rows": rows})

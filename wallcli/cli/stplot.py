@@ -63,6 +63,10 @@ def stplot(
             plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)
     with committed_together():  # the .npz, the PNG and the JSON: all or none
         _write(plot, input, output, png, style, gain, json_out, force)
+    from wallcli.cli.output import wrote
+
+    shape = f"{plot.bins} positions x {plot.frames} frames"
+    wrote((output, f"horizontal and vertical space-time plots, {shape}"), (png, "both plots, amplified"))
 
 
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:
