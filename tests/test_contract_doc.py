@@ -78,3 +78,18 @@ def test_every_field_the_shipped_contract_names_is_written(name, outputs):
     missing = named - written - PENDING
     assert not missing, f"docs/contract.md names fields that `{name}` does not write: {sorted(missing)}"
     assert not (PENDING & written), f"now written, drop from PENDING: {sorted(PENDING & written)}"
+
+
+def test_a_csv_row_holds_each_answer_with_the_signal_it_was_judged_on(outputs):
+    """README: the CSV holds per row what the JSON line holds for each task's answer."""
+    from wallcli.batch.results import csv_columns, flatten
+
+    line = outputs["scan"]
+    classes = {t: line[t]["classes"] for t in ("count", "activity")}
+    cols = csv_columns(("count", "activity", "snr"), classes)
+    row = dict(zip(cols, flatten(line, cols)))
+    for task in ("count", "activity"):
+        for field in ("label", "confident", "reason", "signal_db"):
+            assert f"{task}.{field}" in cols
+        assert float(row[f"{task}.signal_db"]) == line[task]["signal_db"]
+        assert row[f"{task}.label"] == str(line[task]["label"])

@@ -110,6 +110,9 @@ def test_verdicts_are_what_the_commands_answer(clip_report, hostile_clip, run_cl
     assert [float(p) for p in probs] == pytest.approx(ref["probabilities"], abs=6e-4)
     windows = table_rows(section.find_all("table", class_="windows")[0])
     assert [float(w[0]) for w in windows] == pytest.approx([w["start"] for w in ref["windows"]], abs=0.006)
+    # the figure each answer was judged on, as the JSON and the terminal write it
+    assert [w[3] for w in windows] == [f"{w['signal_db']:.1f}".replace("-0.0", "0.0") for w in ref["windows"]]
+    assert f"signal {ref['signal_db']:.1f} dB".replace("-0.0", "0.0") in verdict
     assert len(section.find_all("img")) == 1
 
 

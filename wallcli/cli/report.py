@@ -32,8 +32,9 @@ def report(
     limits in plain words. The video is decoded once. A clip too short for one 8.5 s window
     still gets its page, whose answers say why there are none.
 
-    For the .jsonl of 'wallcli scan': one row per video (name, duration, SNR, count, activity,
-    confident, error), sortable by any column and filterable by text, with totals on top.
+    For the .jsonl of 'wallcli scan': one row per video (name, duration, pixel SNR, count and
+    activity with the signal each was judged on, error), sortable by any column and filterable
+    by text, with totals on top (how many answers each task decided).
 
     Images are embedded and the page loads nothing from anywhere: no network, scripts or fonts
     from outside. Every name and value from the input is shown as text, never as markup.
