@@ -1,4 +1,4 @@
-"""``wallcli amplify``: video -> the amplified-signal video (seed Figure 1), in one streaming pass."""
+"""``wallcli amplify``: video -> the amplified-signal video (as in the paper's Figure 1), in one streaming pass."""
 
 from __future__ import annotations
 

@@ -26,7 +26,8 @@ def report(
 
     For a video: the evidence's identity (size, sha256, container, codec, resolution, frame
     rate, frames decoded, decode warnings), a frame with the region analysed, signal and noise
-    per block size and where on the wall the signal is (seed §3.2), both space-time plots, the
+    per block size and where on the wall the signal is (Sharma et al., What You Can Learn by
+    Staring at a Blank Wall, ICCV 2021, supplementary §3.2), both space-time plots, the
     count and activity answers with their per-window probabilities (or 'undetermined' and why),
     the models with their validated accuracy and what they cannot do, and the method and its
     limits in plain words. The video is decoded once. A clip too short for one 8.5 s window

@@ -53,7 +53,7 @@ def simulate(
                                        "to pixels (default 64x64 for a video, 24x32 in dataset mode, for speed: the signal is smooth)."),
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality for .mp4 (0 = lossless, 18 = visually clean, 28 = "
                             "strong compression that erases faint signals)."),
-    world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the seed's 2-D world "
+    world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the paper's 2-D world (supplementary §4) "
                               "(people = 1-2 moving occluders, horizontal information only); pt: the same rooms and "
                               "motions path traced by Mitsuba 3 (people of boxes, three bounces; needs "
                               "pip install 'wallcli[pt]'; slow on a CPU, meant for a GPU); mixed (--dataset only): room "

@@ -1,5 +1,5 @@
 """``wallcli snr``: how much wall signal a video carries, where, and how it grows with averaging;
-or, with ``--predict``, what the physics of seed §3 expects for a scene and camera."""
+or, with ``--predict``, what the physics of the paper (supplementary §3.1) expects for a scene and camera."""
 
 from __future__ import annotations
 
@@ -54,7 +54,7 @@ def snr(
     max_pixels: int = number_option(32768, "--max-pixels", lo=0, hi=2**31, integer=True, help="Pixels measured per frame: a larger ROI is sampled by a regular "
                                    "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
                                    "decode speed). 0 = every pixel of the ROI (exact, slower)."),
-    predict_mode: bool = typer.Option(False, "--predict", help="Predict from the scene's physics (seed §3.1) instead of measuring a video."),
+    predict_mode: bool = typer.Option(False, "--predict", help="Predict from the scene's physics (the paper's supplementary §3.1) instead of measuring a video."),
     approx: bool = typer.Option(False, "--approx", help="--predict: far-field coverage A/(pi d^2) instead of the exact r^2/(r^2+d^2)."),
     sweep: Optional[str] = typer.Option(None, "--sweep", help="--predict: NAME=start:stop:step over any parameter, e.g. distance=1:4:0.25 "
                                         "(names: " + ", ".join(k.replace("_", "-") for k in PREDICT_PARAMS) + ")."),
@@ -75,7 +75,8 @@ def snr(
     force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
-    """Measure the wall signal and the noise in a video (seed §4), per colour channel.
+    """Measure the wall signal and the noise in a video, per colour channel (Sharma et al., What
+    You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §3.2).
 
     V is the video with each pixel's temporal mean removed and T(V) is V one frame later. The
     signal is slow and frame noise independent, so noise power = 1/2 Var(V - T(V)), signal power
@@ -253,7 +254,7 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
         if json_out:
             emit_json({"mode": "predict", "parameters": settings, **out})
             return
-        print_table("snr --predict (seed §3.1)" + (", far-field approximation" if approx else ""),
+        print_table("snr --predict (Sharma et al., ICCV 2021, supplementary §3.1)" + (", far-field approximation" if approx else ""),
                     ["quantity", "value"], [[k, f"{v:.6g}" if v is not None else "-"] for k, v in out.items()])
         if params["mean_code"] is None:
             warn("no camera model: give --mean-code and --gain for noise power and SNR")

@@ -1,4 +1,4 @@
-"""Signal and noise of a wall video (seed notes §4) and their prediction from physics (§3).
+"""Signal and noise of a wall video (Sharma et al. 2021, supplementary §3.2) and their prediction from physics (§3.1).
 
 Estimator. V is the video with each pixel's temporal mean removed and T shifts it by one frame.
 The signal is slow, so V - T(V) is (almost) noise alone and frame noise is independent:
