@@ -145,5 +145,5 @@ def _simulated_note(card: dict) -> str | None:
     others = [o for o in others if isinstance(o.get("accuracy"), (int, float))]
     more = "".join(f"; {o['accuracy']:.0%}{ci(o)} of visible windows on another set" for o in others)
     return (f"right on {vis['accuracy']:.0%}{ci(vis)} of "
-            f"validation windows where the people are visible (>= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
+            f"simulated windows where the people are visible (their signal >= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
             f"{ci(v)} of all{more}; a faint or distant mover reads as nobody. See the model card.")
