@@ -255,7 +255,7 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
             emit_json({"mode": "predict", "parameters": settings, **out})
             return
         print_table("snr --predict (Sharma et al., ICCV 2021, supplementary §3.1)" + (", far-field approximation" if approx else ""),
-                    ["quantity", "value"], [[k, f"{v:.6g}" if v is not None else "-"] for k, v in out.items()])
+                    ["quantity", "value"], [[k, _shown(k, v)] for k, v in out.items()])
         if params["mean_code"] is None:
             warn("no camera model: give --mean-code and --gain for noise power and SNR")
         return
@@ -281,4 +281,13 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
     cols = [key.replace("_", "-"), "theta", "amplitude", "signal_power"] + (
         ["noise_power", "snr_db"] if "noise_power" in rows[0] else [])
     print_table(f"snr --predict, sweeping {key.replace('_', '-')}", cols,
-                [[f"{r[c]:.6g}" if c in r and r[c] is not None else "-" for c in [key] + cols[1:]] for r in rows])
+                [[_shown(c, r.get(c)) for c in [key] + cols[1:]] for r in rows])
+
+
+def _shown(name: str, value) -> str:
+    """A predicted quantity for the table: dB as every output writes dB, the rest to 6 digits."""
+    from wallcli.wording import format_db
+
+    if value is None:
+        return "-"
+    return format_db(value) if name.endswith("_db") else f"{value:.6g}"
