@@ -22,6 +22,11 @@ def format_db(x) -> str:
     return "0.0" if text == "-0.0" else text
 
 
+def plural(n: int, word: str, words: str | None = None) -> str:
+    """'1 video', '2 videos' ('1 person', '3 people' with ``words``)."""
+    return f"{n} {word if n == 1 else (words or word + 's')}"
+
+
 def label_text(label) -> str:
     """An answer as words: count's 1 -> '1 person', 0 -> '0 people'; activity's labels as they are."""
     if isinstance(label, int) and not isinstance(label, bool):

@@ -80,7 +80,9 @@ def scan(
         summary = run_scan(inputs, output, tasks=tasks, workers=workers, scheduler=scheduler, globs=glob,
                            force=force, windows=windows, timeout=timeout, encode=to_json, log=lambda m: log(m, wrap=False),
                            on_start=bar.start, on_line=on_line, debug=debug)
-    log(f"scan: {summary['videos']} videos: {summary['ok']} done, {summary['failed']} failed, "
+    from wallcli.wording import plural
+
+    log(f"scan: {plural(summary['videos'], 'video')}: {summary['ok']} done, {summary['failed']} failed, "
         f"{summary['skipped']} already done; {summary['hours']:.2f} h of video in {summary['seconds']:.1f} s "
         f"({summary['videos_per_second']:.2f} videos/s) -> {summary['output']}", wrap=False)
     if json_out:
