@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Set up wallcli (once, into .venv) and run the main job on a bundled example clip:
 # how strong is the signal, the space-time plots, how many people, what they do, and the
-# amplified video. Outputs go to examples/out/.
+# amplified video. Outputs go to out/ at the top of the checkout (git-ignored): outside
+# examples/, so that `wallcli scan examples` finds the bundled clips only, not this script's
+# amplified video (which is no wall).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ ! -x .venv/bin/wallcli ]; then
@@ -11,7 +13,7 @@ if [ ! -x .venv/bin/wallcli ]; then
 fi
 w=.venv/bin/wallcli
 clip=${1:-examples/walking.mp4}
-out=examples/out
+out=out
 mkdir -p "$out"
 
 echo "== signal and noise ($clip)" >&2

@@ -6,17 +6,18 @@ set -euo pipefail
 cd "$(dirname "$0")"
 W=${WALLCLI:-../.venv/bin/wallcli}
 PY=${PYTHON:-../.venv/bin/python}
-mkdir -p out
-$W report walking.mp4 -o out/walking-report.html --force
+# the page goes to out/ at the top of the checkout, outside examples/ (see pipeline.sh)
+mkdir -p ../out
+$W report walking.mp4 -o ../out/walking-report.html --force
 profile=$(mktemp -d)
 trap 'rm -rf "$profile"' EXIT
 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking \
   --disable-component-update --disable-sync --hide-scrollbars --user-data-dir="$profile" \
-  --window-size=1100,2000 --screenshot="$PWD/out/report-full.png" "file://$PWD/out/walking-report.html" 2>/dev/null
+  --window-size=1100,2000 --screenshot="$PWD/../out/report-full.png" "file://$PWD/../out/walking-report.html" 2>/dev/null
 "$PY" - <<'PYEOF'
 from PIL import Image
 
-with Image.open("out/report-full.png") as im:
+with Image.open("../out/report-full.png") as im:
     im = im.convert("RGB")
     small = im.resize((im.width * 6 // 10, im.height * 6 // 10), Image.LANCZOS)
 small.quantize(colors=256, method=Image.Quantize.MEDIANCUT).save("report.png", optimize=True)

@@ -17,7 +17,7 @@ from pathlib import Path
 from wallcli.infer.card import card_path, read_card, write_card
 from wallcli.io.writer import atomic_path
 
-KEYS = ("dir", "clips", "scored", "errors", "accuracy", "ci95", "decided", "coverage", "accuracy_decided",
+KEYS = ("clips", "scored", "errors", "accuracy", "ci95", "decided", "coverage", "accuracy_decided",
         "ci95_decided", "classes", "confusion", "per_class", "all")
 
 
@@ -29,10 +29,12 @@ def main() -> None:
     card = read_card(model)
     if result.get("model", {}).get("sha256") != card["sha256"]:
         raise SystemExit(f"{result_path} measured another model ({result.get('model')}), not {model}")
-    block = {k: result[k] for k in KEYS if k in result}
+    # the set by what it is: the folder it sits in here means nothing to a reader of the card
+    block = {"description": f"independent path-traced transfer set, {result.get('scored')} clips (not shipped with wallcli)",
+             **{k: result[k] for k in KEYS if k in result}}
     block["source"] = ("an independent path-traced renderer (other code, box people, area lights, its own camera "
                        "model), never trained or calibrated on")
-    block["command"] = f"wallcli evaluate {result.get('dir')} --task {result['task']} --json"
+    block["command"] = f"wallcli evaluate TRANSFER_DIR --task {result['task']} --json"
     card["transfer"] = block
     with atomic_path(card_path(model), force=True) as tmp:
         write_card(tmp, card)

@@ -71,3 +71,52 @@ def test_projector_runs_opencv_on_one_thread_and_restores_the_callers_setting(mo
         assert cv2.getNumThreads() == 3  # and a library caller's choice is back
     finally:
         cv2.setNumThreads(before)
+
+
+def test_the_buffered_8_bit_sums_equal_the_general_exact_ones():
+    """ProjectionPlan's fast path (8-bit plane, whole-pixel rectangle: OpenCV float32 sums into
+    buffers made once) gives exactly what the general path gives for the same values in 16 bits."""
+    from wallcli.signal.blocks import ProjectionPlan
+
+    rng = np.random.default_rng(5)
+    plane = rng.integers(0, 256, (1080, 1920), dtype=np.uint8)
+    plane[:, 7] = 255  # a column of the largest sum: 1080 x 255 must still be exact in float32
+    plan = ProjectionPlan(bin_edges(0, 1080, 64), bin_edges(0, 1920, 64))
+    fast = plan(plane)
+    assert plan._fast is True
+    general = ProjectionPlan(bin_edges(0, 1080, 64), bin_edges(0, 1920, 64))(plane.astype(np.uint16))
+    for a, b in zip(fast, general):
+        assert np.array_equal(a, b)
+    for a, b in zip(fast, plan(plane)):  # a second frame through the same buffers
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("kind", ["yuv", "gray", "rgb", "yuv-full-10bit"])
+def test_the_projector_converts_to_rgb_as_to_rgb_does(kind):
+    """The projector's one affine map per format equals Planes.to_rgb on the same means."""
+    from wallcli.io.video import Planes
+    from wallcli.signal.blocks import RgbProjector, projection_means
+
+    rng = np.random.default_rng(6)
+    deep = kind.endswith("10bit")
+    hi, dt = (1024, np.uint16) if deep else (256, np.uint8)
+    y = rng.integers(0, hi, (90, 160), dtype=dt)
+    if kind == "gray":
+        planes = Planes(y, None, None, kind="gray")
+    elif kind == "rgb":
+        planes = Planes(y, rng.integers(0, 256, (90, 160), dtype=dt), rng.integers(0, 256, (90, 160), dtype=dt), kind="rgb")
+    else:
+        planes = Planes(y, rng.integers(0, hi, (45, 80), dtype=dt), rng.integers(0, hi, (45, 80), dtype=dt),
+                        sub_x=1, sub_y=1, depth=10 if deep else 8, matrix="bt709", full_range=deep)
+    roi = (3, 2, 150, 84)
+    h, v = RgbProjector(roi, 16)(planes)
+    rows, cols = bin_edges(2, 86, 16), bin_edges(3, 153, 16)
+    yc, yr = projection_means(planes.y, rows, cols)
+    if planes.u is None:
+        want_h, want_v = planes.to_rgb(yc), planes.to_rgb(yr)
+    else:
+        sx, sy = 1 << planes.sub_x, 1 << planes.sub_y
+        uc, ur = projection_means(planes.u, rows / sy, cols / sx)
+        vc, vr = projection_means(planes.v, rows / sy, cols / sx)
+        want_h, want_v = planes.to_rgb(yc, uc, vc), planes.to_rgb(yr, ur, vr)
+    assert np.allclose(h, want_h, rtol=0, atol=1e-4) and np.allclose(v, want_v, rtol=0, atol=1e-4)

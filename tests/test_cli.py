@@ -29,6 +29,27 @@ def test_command_help(run_cli, name):
     assert "Usage:" in out and "--help" in out
 
 
+@pytest.mark.parametrize("name", COMMANDS)
+def test_help_names_every_value_in_one_style(run_cli, name):
+    """Usage reads `wallcli CMD [OPTIONS] INPUT` ([INPUT] when optional, INPUT... when repeated),
+    and every option that takes a value names it in capitals (PATH, TEXT, INTEGER, NUMBER, X,Y,W,H),
+    never typer's {input}, [input] or <list[str]>; help cites files a user has (docs/contract.md)."""
+    import re
+
+    code, out, _ = run_cli(name, "--help")
+    usage = next(line for line in out.splitlines() if line.startswith("Usage:"))
+    assert re.fullmatch(rf"Usage: wallcli {name} \[OPTIONS\]( (\[[A-Z]+\]|[A-Z]+(\.\.\.)?))*", usage), usage
+    assert not re.search(r"<[a-z\[\]]+>|\{[A-Za-z]+\}", out)
+    entries = re.findall(r"^  (-[-\w]+(?:, -[-\w]+)?)(?: (\S+))?  ", out, re.M)
+    assert entries
+    for flags, value in entries:
+        shape = re.sub(r"(?<=[A-Z])x(?=[A-Z])|\|[a-z]+", "", value)  # WxH, X,Y,W,H|auto: literal parts
+        assert shape == shape.upper(), (flags, value)
+    assert "CONTRACT.md" not in out and "seed §" not in out and "seed notes" not in out
+    if name == "snr":  # the estimator is the paper's supplementary §3.2 (help once said §4)
+        assert "Staring at a Blank Wall, ICCV 2021, supplementary §3.2" in " ".join(out.split())
+
+
 def test_help_does_not_import_heavy_modules():
     code = (
         "import sys; from wallcli.cli.app import app; "

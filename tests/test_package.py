@@ -32,6 +32,16 @@ def test_models_folder_holds_no_script_and_ships_only_models_and_cards():
     assert (ROOT / "research" / "README.md").is_file()
 
 
+def test_every_folder_of_the_package_is_declared():
+    """setuptools treats any folder under a package as a package; one missing from `packages`
+    (templates/, a folder of data) made every install print a 40-line warning."""
+    tomllib = pytest.importorskip("tomllib")
+    packages = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    folders = {".".join(d.relative_to(ROOT).parts) for d in (ROOT / "wallcli").rglob("*")
+               if d.is_dir() and d.name != "__pycache__" and any(f.is_file() for f in d.iterdir())}
+    assert sorted(folders - packages) == []
+
+
 def test_installed_models_package_holds_models_cards_and_nothing_else():
     pkg = Path(str(resources.files("wallcli.models")))
     if pkg.resolve() == (ROOT / "models").resolve():

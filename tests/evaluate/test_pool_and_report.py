@@ -58,4 +58,4 @@ def test_the_table_says_undetermined_with_the_reason(capsys):
     out = " ".join(capsys.readouterr().out.split())
     assert "undetermined [1]" in out and "[1] signal 3 dB under" in out
     assert "error [2]" in out and "[2] no such file: c.mp4" in out
-    assert "right │ 1 (33.3 %)" in out and "decided │ 1 (33 %)" in out  # right; decided (coverage)
+    assert "right 1 (33.3 %)" in out and "decided 1 (33 %)" in out  # right; decided (coverage)

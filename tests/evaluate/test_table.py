@@ -37,13 +37,14 @@ def test_sixty_clips_fit_80_columns_one_line_each(monkeypatch, capsys):
     print_evaluation(_result(60, 1))
     lines = capsys.readouterr().out.splitlines()
     assert max(len(x) for x in lines) <= 80
-    top, bottom = lines.index(next(x for x in lines if x.startswith("┡"))), lines.index(next(x for x in lines if x.startswith("└")))
+    top = lines.index(next(x for x in lines if x.startswith("─")))  # the rule under the header
+    bottom = lines.index(next(x for x in lines[top:] if x.startswith("[1] ")))  # the footnotes follow the rows
     assert bottom - top - 1 == 60  # no row wraps
     res = _result(60, 1)
     assert all(r["file"] in x for r, x in zip(res["rows"], lines[top + 1:bottom]))  # whole names, not cut
     text = "\n".join(lines)
     assert "undetermined [1]" in text and "\n[1] p=0.001 for 'none' at -19 dB; 97% right only from p=0.994" in text
-    assert "error [" in text and "Invalid data found" in text.split("└", 1)[1]
+    assert "error [" in text and "Invalid data found" in "\n".join(lines[bottom:])
     assert lines[:2] == ["transfer (labels: labels.csv)", "activity by wallcli-activity 0.3.1, 60 clips"] and "\n1 clip skipped: more than one person" in text
     assert len(lines) < 2 * 60 + 40  # footnotes: a line or two each, not five lines a row as before
 

@@ -1,4 +1,4 @@
-"""Small `wallcli scan` results (CONTRACT.md: one JSON object per video and line), written by hand:
+"""Small `wallcli scan` results (docs/contract.md: one JSON object per video and line), written by hand:
 answers decided and undetermined, results from before the confident flag, a failed video, a
 hostile file name and a last line cut short by a killed scan."""
 from __future__ import annotations
@@ -27,12 +27,15 @@ def _answer(task, label, probs, **extra):
 
 RECORDS = [
     {"input": "cam1/0001.mp4", "size": 1_234_567, "sha256": "a" * 64, "duration": 12.0, "frames": 360,
-     "count": _answer("count", 1, [0.02, 0.93, 0.05], confident=True, reason=None),
-     "activity": _answer("activity", "walking", [0.05, 0.9, 0.03, 0.01, 0.01], confident=True, reason=None),
+     "count": _answer("count", 1, [0.02, 0.93, 0.05], confident=True, reason=None, signal_db=12.46),
+     "activity": _answer("activity", "walking", [0.05, 0.9, 0.03, 0.01, 0.01], confident=True, reason=None,
+                         signal_db=-0.04),
      "snr": _snr([0.5, 0.4, 0.6], [0.2, 0.2, 0.3]), "error": None},
     {"input": f"cam1/{HOSTILE}.mp4", "size": 2_000_000, "sha256": "b" * 64, "duration": 30.5, "frames": 915,
-     "count": _answer("count", 2, [0.1, 0.3, 0.6], confident=False, reason="signal 3 dB under the model's validated range"),
-     "activity": _answer("activity", "none", [0.9, 0.04, 0.03, 0.02, 0.01], confident=True, reason=None),
+     "count": _answer("count", 2, [0.1, 0.3, 0.6], confident=False, reason="signal 3 dB under the model's validated range",
+                      signal_db=-30.0),
+     "activity": _answer("activity", "none", [0.9, 0.04, 0.03, 0.02, 0.01], confident=True, reason=None,
+                         signal_db=-28.5),
      "snr": _snr([0.01, 0.01, 0.01], [1.0, 1.0, 1.0]), "error": None},
     {"input": "cam2/old.mp4", "size": 500_000, "sha256": "c" * 64, "duration": 9.0, "frames": 270,
      "count": _answer("count", 0, [0.8, 0.15, 0.05]),  # written before the confident flag existed

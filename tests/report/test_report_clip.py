@@ -110,6 +110,9 @@ def test_verdicts_are_what_the_commands_answer(clip_report, hostile_clip, run_cl
     assert [float(p) for p in probs] == pytest.approx(ref["probabilities"], abs=6e-4)
     windows = table_rows(section.find_all("table", class_="windows")[0])
     assert [float(w[0]) for w in windows] == pytest.approx([w["start"] for w in ref["windows"]], abs=0.006)
+    # the figure each answer was judged on, as the JSON and the terminal write it
+    assert [w[3] for w in windows] == [f"{w['signal_db']:.1f}".replace("-0.0", "0.0") for w in ref["windows"]]
+    assert f"signal {ref['signal_db']:.1f} dB".replace("-0.0", "0.0") in verdict
     assert len(section.find_all("img")) == 1
 
 
@@ -140,8 +143,8 @@ def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monke
     for ext in ("onnx", "json"):
         shutil.copy(f"{_models_dir()}/count.{ext}", tmp_path / f"count.{ext}")
     card = json.loads((tmp_path / "count.json").read_text())
-    card["transfer"] = {"dir": "transfer", "scored": 52, "accuracy": 0.9231, "ci95": [0.85, 0.97], "coverage": 0.8,
-                        "accuracy_decided": 0.98, "command": "wallcli evaluate transfer --task count --json",
+    card["transfer"] = {"description": "clips of another renderer", "scored": 52, "accuracy": 0.9231, "ci95": [0.85, 0.97], "coverage": 0.8,
+                        "accuracy_decided": 0.98, "command": "wallcli evaluate DIR --task count --json",
                         "renderer": "<b>path tracer</b>"}
     (tmp_path / "count.json").write_text(json.dumps(card))
     import wallcli.io.video as video
@@ -166,11 +169,35 @@ def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monke
     assert "undetermined" not in activity.find_all("p", class_="verdict")[0].text()
 
     models = page.by_id("models").text()
-    assert "transfer: right on 92.3 % (95 % interval 85–97 %) of 52 clips; 80.0 % of clips decided, 98.0 %" in models
-    assert "wallcli evaluate transfer --task count --json" in models
+    assert ("clips of another renderer: right on 92.3 % (95 % interval 85–97 %) of 52 clips; 80.0 % of clips "
+            "decided, 98.0 %") in models
+    assert "wallcli evaluate DIR --task count --json" in models
     assert "renderer: <b>path tracer</b>" in models  # unknown fields shown as they are, as text
     assert not page.find_all("script")
     assert all("path tracer" not in b.text() for b in page.find_all("b"))  # the page's own <b> only
+
+
+def test_data_sets_are_named_by_what_they_are_not_where_they_were():
+    """Cards name their sets by a description; a card that only has its author's folder (dir,
+    dataset) is described from its recipe, and neither that folder nor a command naming it shows."""
+    from wallcli.report.cards import _transfer, set_name
+
+    for task in ("count", "activity"):
+        card = json.loads((_models_dir() / f"{task}.json").read_text())
+        v = card["validation"]
+        assert set_name(v["source"], "x").startswith("simulated validation set")
+        assert "independent path-traced transfer set" in _transfer(card["transfer"])[0]["set"]
+    old = {"dir": "../shared/transfer", "command": "wallcli evaluate ../shared/transfer --task count --json",
+           "accuracy": 0.5, "scored": 60}
+    shown = _transfer(old)[0]
+    assert shown["set"] == "transfer set" and shown["command"] is None and "../shared" not in json.dumps(shown)
+    assert set_name({"dataset": "data/val_count6", "recipe": {"domain": "shifted"}, "windows": 1024},
+                    "simulated validation set") == "simulated validation set: shifted rooms, 1,024 windows"
+
+
+def test_the_page_names_no_folder_of_the_models_author(clip_report):
+    text = clip_report.read_text(encoding="utf-8")
+    assert "../shared" not in text and "data/val_" not in text and "seed §" not in text
 
 
 def _models_dir():

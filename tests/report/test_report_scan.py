@@ -24,14 +24,14 @@ def index(tmp_path, run_cli):
 def test_one_row_per_video_with_its_answers(index):
     rows = table_rows(parse(index).by_id("results"))
     assert [r[0] for r in rows] == ["cam1/0001.mp4", f"cam1/{HOSTILE}.mp4", "cam2/old.mp4", "cam2/broken.mp4", "(line 5)"]
-    name, duration, snr, count, activity, confident, error = zip(*rows)
+    name, duration, snr, count, count_db, activity, activity_db, error = zip(*rows)
     assert duration == ("12.00", "30.50", "9.00", "", "")
-    # per-pixel SNR of R, G and B together: 10 log10(mean signal / mean noise); no signal is -99
-    assert snr == ("3.3", "-20.0", "-99.0", "", "")
+    # figures as the results hold them: snr.snr_db of green, each task's signal_db; never "-0.0"
+    assert snr == tuple(f"{r['snr']['snr_db'][1]:.1f}" for r in RECORDS[:3]) + ("", "") == ("3.0", "-20.0", "-99.0", "", "")
+    assert count_db == ("12.5", "-30.0", "", "", "") and activity_db == ("0.0", "-28.5", "", "", "")
     assert count == ("1 person (p 0.93)", "undetermined (signal 3 dB under the model's validated range)",
                      "0 people (p 0.80)", "", "")
     assert activity == ("walking (p 0.90)", "none (p 0.90)", "none (p 0.70)", "", "")
-    assert confident == ("yes", "no", "", "", "")  # old results carry no flag: unknown, not "yes"
     assert error[:3] == ("", "", "") and error[3].startswith("cam2/broken.mp4 is not a readable video")
     assert error[4].startswith("line 5 is not JSON")
 
@@ -40,7 +40,8 @@ def test_sort_keys_are_numbers_and_blanks(index):
     body = parse(index).by_id("results").find_all("tbody")[0]
     keys = [[td.attrs.get("data-sort") for td in tr.find_all("td")] for tr in body.find_all("tr")]
     assert [k[1] for k in keys] == ["12.0", "30.5", "9.0", "", ""]
-    assert float(keys[0][2]) == pytest.approx(10 * math.log10(0.5 / (0.7 / 3)))
+    assert float(keys[0][2]) == pytest.approx(10 * math.log10(0.4 / 0.2))
+    assert [k[4] for k in keys] == ["12.46", "-30.0", "", "", ""]
 
 
 def test_totals_on_top(index):
@@ -49,8 +50,9 @@ def test_totals_on_top(index):
     assert page.by_id("total-ok").text() == "3"
     assert page.by_id("total-failed").text() == "2"
     assert page.by_id("total-duration").text() == "51.50 s"
-    assert page.by_id("total-confident").text() == "1"
-    assert page.by_id("total-undetermined").text() == "1"
+    # each task on its own: count left one video undetermined, activity none (old results: decided)
+    assert page.by_id("total-count-decided").text() == "2 of 3"
+    assert page.by_id("total-activity-decided").text() == "3 of 3"
     assert page.by_id("tally-count").text() == "count: 0 people: 1 · 1 person: 1 · undetermined: 1"
     assert page.by_id("tally-activity").text() == "activity: none: 2 · walking: 1"
     assert "line 5 is not JSON" in page.by_id("problems").text()

@@ -58,7 +58,7 @@ def test_simulate_usage_errors_exit_2(tmp_path, run_cli, args):
                     reason="needs taskset and two CPUs")
 def test_simulated_h264_does_not_depend_on_the_number_of_cores(tmp_path):
     """x264's output changes with its thread count, and FFmpeg's default is one per core: the
-    same seed must give the same file on a laptop and on a 64-core server (CONTRACT.md)."""
+    same seed must give the same file on a laptop and on a 64-core server (docs/contract.md)."""
     args = [sys.executable, "-m", "wallcli", "simulate", "--people", "1", "--seed", "3", "--duration", "1",
             "--size", "640x360"]
     one, all_ = tmp_path / "one.mp4", tmp_path / "all.mp4"

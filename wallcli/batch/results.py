@@ -39,6 +39,7 @@ def csv_columns(tasks, classes: dict[str, list], windows: bool = False) -> list[
     for task in ("count", "activity"):
         if task in tasks:
             cols += [f"{task}.label", f"{task}.confident", f"{task}.reason"]
+            cols += [f"{task}.signal_db"]  # what the answer was judged on; the JSON line has it too
             cols += [f"{task}.probabilities.{c}" for c in classes[task]]
             cols += [f"{task}.model.name", f"{task}.model.version", f"{task}.model.sha256"]
             cols += [f"{task}.windows"] if windows else []

@@ -10,19 +10,19 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
                            help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
-JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see CONTRACT.md).")
+JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see docs/contract.md).")
 PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
                         "(for a video, the plot drawn is averaged down to at most 2048 time columns).")
 MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
 THREADS_OPT = threads_option("onnxruntime intra-op threads (0: onnxruntime chooses).")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
-FORCE_OPT = typer.Option(False, "--force", help="Overwrite the --plot file.")
+FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
 INPUT_ARG = input_argument(INPUT_HELP)
 
 
@@ -65,10 +65,13 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
                                         progress=advance, keep_plot=plot is not None)
     with committed_together():  # the figure and the data on stdout: all or none
         _report(task, input, model, result, st, plot, json_out, force)
+    from wallcli.cli.output import wrote
+
+    wrote((plot, "class probabilities over time above the horizontal space-time plot"))
 
 
 def _report(task, input, model, result, st, plot, json_out, force) -> None:
-    from wallcli.cli.output import emit_json, print_table
+    from wallcli.cli.output import emit_json, print_lines, print_table
 
     if plot is not None:
         from wallcli.plots.timeline import save_timeline_png
@@ -78,20 +81,26 @@ def _report(task, input, model, result, st, plot, json_out, force) -> None:
         emit_json(result)
         return
     # one row per window (each lasts window/fps seconds from its start) and the clip's answer;
-    # no 'end' column so that five classes fit an 80-column terminal
-    classes = result["classes"]
+    # no 'end' column, and reasons under the table, so that five classes fit 80 columns
+    from wallcli.wording import answer_text, format_db, label_text
 
     def shown(r):  # an answer that may not be relied upon is not shown as one
         return str(r["label"]) if r.get("confident", True) else "undetermined"
 
-    rows = [[f"{w['start']:.2f}", shown(w), f"{w.get('signal_db', float('nan')):.0f}", *(f"{p:.3f}" for p in w["probabilities"])]
-            for w in result["windows"]]
-    rows.append(["clip", shown(result), f"{result.get('signal_db', float('nan')):.0f}", *(f"{p:.3f}" for p in result["probabilities"])])
+    def row(first, r):
+        return [first, shown(r), format_db(r.get("signal_db")), *(f"{p:.3f}" for p in r["probabilities"])]
+
+    rows = [row(f"{w['start']:.2f}", w) for w in result["windows"]] + [row("clip", result)]
     span = result["window"] / result["fps"]
-    answer = (f"{result['label']} (p={max(result['probabilities']):.2f}" if result.get("confident", True)
-              else f"undetermined ({result.get('reason')}; most likely {result['label']}, p={max(result['probabilities']):.2f}")
-    print_table(f"{input}: {task} = {answer}; {len(result['windows'])} windows of {span:.2f} s)",
-                ["start (s)", "answer", "signal dB", *(f"{c} people" if isinstance(c, int) else str(c) for c in classes)], rows)
+    n = len(result["windows"])
+    print_table(f"{input}: {task} = {answer_text(result)}; {n} window{'' if n == 1 else 's'} of {span:.2f} s",
+                ["start (s)", "answer", "signal dB", *map(label_text, result["classes"])], rows)
+    notes = []
+    if not result.get("confident", True):
+        notes.append(f"undetermined: {result.get('reason') or 'no reason given'}.")
+    if any(not w.get("confident", True) for w in result["windows"]):
+        notes.append("Each window's reason: --json (windows[].reason).")
+    print_lines(notes)
     note = accuracy_note(model.card)
     if note:
         from wallcli.cli.output import log
@@ -136,5 +145,5 @@ def _simulated_note(card: dict) -> str | None:
     others = [o for o in others if isinstance(o.get("accuracy"), (int, float))]
     more = "".join(f"; {o['accuracy']:.0%}{ci(o)} of visible windows on another set" for o in others)
     return (f"right on {vis['accuracy']:.0%}{ci(vis)} of "
-            f"validation windows where the people are visible (>= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
+            f"simulated windows where the people are visible (their signal >= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
             f"{ci(v)} of all{more}; a faint or distant mover reads as nobody. See the model card.")

@@ -22,7 +22,8 @@ def activity(
     """Recognise what a person out of view is doing: none, walking, crouching, waving or jumping.
 
     Both space-time plots (horizontal and vertical) are cut into 256-frame windows (8.5 s at 30 fps, any
-    input frame rate is resampled); the seed's two-branch CNN classifies each; the clip's answer is
+    input frame rate is resampled); the paper's two-branch CNN classifies each (Sharma et al., What
+    You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §2); the clip's answer is
     the mean of the window probabilities.
 
     \b

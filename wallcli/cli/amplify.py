@@ -1,4 +1,4 @@
-"""``wallcli amplify``: video -> the amplified-signal video (seed Figure 1), in one streaming pass."""
+"""``wallcli amplify``: video -> the amplified-signal video (as in the paper's Figure 1), in one streaming pass."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # Frames held back while the automatic gain calibrates are kept whole only with --side-by-side
@@ -56,7 +56,7 @@ def amplify(
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),
     preset: str = typer.Option("superfast", "--preset", help="x264 speed preset, ultrafast ... veryslow. superfast: 2x faster than veryfast, same size here; ultrafast: 2x faster again, 2x bigger."),
     json_out: bool = typer.Option(False, "--json", help="Print a summary (gain, frames, fps, size) as JSON on stdout."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("OUTPUT")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Make the invisible visible: a video of the wall's tiny light changes, amplified.
@@ -96,7 +96,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
 
     import numpy as np
 
-    from wallcli.cli.output import console_err, emit_json, progress
+    from wallcli.cli.output import emit_json, progress, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import VideoWriter, atomic_path
@@ -151,7 +151,8 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds, "smooth": smooth,
         "gain": amp.gain, "gain_mode": "auto" if amp.auto_gain else "fixed", "sigma": amp.sigma,
     }
-    console_err.print(f"amplify: {frames} frames -> {output} ({out_w}x{ph}, gain {amp.gain:.4g} "
-                      f"{'auto' if amp.auto_gain else 'given'}, grid {cols}x{rows})", highlight=False)
+    # the grid in the order of the JSON's "grid": [rows, cols]
+    wrote((output, f"{frames} frames of {out_w}x{ph} pixels; gain {amp.gain:.4g} "
+                   f"({'automatic' if amp.auto_gain else 'given'}); the wall averaged in {rows} rows x {cols} columns of blocks"))
     if json_out:
         emit_json(summary)

@@ -62,8 +62,10 @@ def _register() -> None:
     # One module per command; each imports only typer and the standard library at module level.
     import importlib
 
+    from wallcli.cli.helpstyle import Command
+
     for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate", "report", "scan"):
-        app.command(name)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
+        app.command(name, cls=Command)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
 
 
 _register()

@@ -10,7 +10,12 @@ import typer
 from wallcli.errors import UsageError
 
 ROI_HELP = "Region of the wall to analyse, x,y,w,h in source pixels (origin top-left). Default: whole frame."
-FORCE_HELP = "Overwrite existing output files."
+
+
+def force_help(what: str) -> str:
+    """``--force``'s help, naming what it overwrites (each command writes different files)."""
+    return f"Overwrite {what} if it exists; without --force an existing file is refused before any work starts."
+
 # More threads than this only adds contention; 100000 of them once took 16 GB and ignored SIGTERM.
 MAX_THREADS = 4 * (os.cpu_count() or 1)
 

@@ -22,7 +22,8 @@ def count(
     """Count the people (0, 1 or 2) moving out of view, from the light on a blank wall.
 
     The horizontal space-time plot is cut into 256-frame windows (8.5 s at 30 fps, any
-    input frame rate is resampled); the seed's CNN classifies each; the clip's answer is
+    input frame rate is resampled); the paper's CNN classifies each (Sharma et al., What You
+    Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §2); the clip's answer is
     the mean of the window probabilities.
 
     \b

@@ -6,7 +6,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, MAX_THREADS, ROI_HELP, number_option
+from wallcli.cli.common import MAX_THREADS, ROI_HELP, force_help, number_option
 
 PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
 
@@ -18,7 +18,7 @@ def evaluate(
     task: str = typer.Option(..., "--task", "-t", help="count or activity."),
     model: Optional[Path] = typer.Option(None, "--model", help="Your own .onnx model (its .json card beside it). "
                                          "Default: the shipped model for --task."),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (CONTRACT.md), rows included."),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (docs/contract.md), rows included."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw a reliability diagram (confidence of the clip "
                                         "answers against how often they are right) and accuracy against measured "
                                         "SNR to this PNG."),
@@ -28,7 +28,7 @@ def evaluate(
                                              "clips whose SNR in dB (labels.csv's snr_db, else the measured one) is "
                                              "at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG, the only file evaluate writes,")),
 ) -> None:
     """Score a model on labelled clips: the check to run before relying on it for a room.
 

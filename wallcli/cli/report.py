@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, parse_roi, threads_option
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
 
@@ -19,21 +19,23 @@ def report(
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
     count_model: Optional[Path] = typer.Option(None, "--count-model", help="Your own count .onnx (its card beside it). Default: the shipped model."),
     activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Write one HTML page that opens offline in any browser and can be handed over as it is.
 
     For a video: the evidence's identity (size, sha256, container, codec, resolution, frame
     rate, frames decoded, decode warnings), a frame with the region analysed, signal and noise
-    per block size and where on the wall the signal is (seed §3.2), both space-time plots, the
+    per block size and where on the wall the signal is (Sharma et al., What You Can Learn by
+    Staring at a Blank Wall, ICCV 2021, supplementary §3.2), both space-time plots, the
     count and activity answers with their per-window probabilities (or 'undetermined' and why),
     the models with their validated accuracy and what they cannot do, and the method and its
     limits in plain words. The video is decoded once. A clip too short for one 8.5 s window
     still gets its page, whose answers say why there are none.
 
-    For the .jsonl of 'wallcli scan': one row per video (name, duration, SNR, count, activity,
-    confident, error), sortable by any column and filterable by text, with totals on top.
+    For the .jsonl of 'wallcli scan': one row per video (name, duration, pixel SNR, count and
+    activity with the signal each was judged on, error), sortable by any column and filterable
+    by text, with totals on top (how many answers each task decided).
 
     Images are embedded and the page loads nothing from anywhere: no network, scripts or fonts
     from outside. Every name and value from the input is shown as text, never as markup.
@@ -79,6 +81,12 @@ def report(
             warn(f"no {task} verdict: {why}")
         html = clip_page(analysis, command=command)
     write_text_atomic(output, html, force=force)
+    from wallcli.cli.output import wrote
+
+    size = len(html.encode("utf-8"))
+    what = "scan summary" if results else "report"
+    shown = f"{size / 1e6:.1f} MB" if size >= 1e6 else f"{max(size / 1e3, 1):.0f} kB"
+    wrote((output, f"{what}, {shown}, self-contained: open it in any browser"))
 
 
 def _command_line(input, output, roi, count_model, activity_model, force, threads) -> str:

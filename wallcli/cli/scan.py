@@ -14,7 +14,7 @@ def scan(
     inputs: List[str] = typer.Argument(..., help="Video files, folders (searched recursively, see --glob), http(s)/rtsp "
                                        "URLs, or @list.txt (one path or URL a line, # comments).", show_default=False,
                                        metavar="INPUT"),
-    output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see CONTRACT.md), "
+    output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see docs/contract.md), "
                                 "or flattened CSV when the name ends in .csv. An existing file is resumed.",
                                 show_default=False),
     task: str = typer.Option("count,activity,snr", "--task", help="Comma list of count, activity, snr: what each video is "
@@ -80,7 +80,9 @@ def scan(
         summary = run_scan(inputs, output, tasks=tasks, workers=workers, scheduler=scheduler, globs=glob,
                            force=force, windows=windows, timeout=timeout, encode=to_json, log=lambda m: log(m, wrap=False),
                            on_start=bar.start, on_line=on_line, debug=debug)
-    log(f"scan: {summary['videos']} videos: {summary['ok']} done, {summary['failed']} failed, "
+    from wallcli.wording import plural
+
+    log(f"scan: {plural(summary['videos'], 'video')}: {summary['ok']} done, {summary['failed']} failed, "
         f"{summary['skipped']} already done; {summary['hours']:.2f} h of video in {summary['seconds']:.1f} s "
         f"({summary['videos_per_second']:.2f} videos/s) -> {summary['output']}", wrap=False)
     if json_out:

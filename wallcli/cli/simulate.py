@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, MAX_THREADS, number_option
+from wallcli.cli.common import MAX_THREADS, force_help, number_option
 
 ACTS = ("none", "walking", "crouching", "waving", "jumping")
 
@@ -53,7 +53,7 @@ def simulate(
                                        "to pixels (default 64x64 for a video, 24x32 in dataset mode, for speed: the signal is smooth)."),
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality for .mp4 (0 = lossless, 18 = visually clean, 28 = "
                             "strong compression that erases faint signals)."),
-    world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the seed's 2-D world "
+    world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the paper's 2-D world (supplementary §4) "
                               "(people = 1-2 moving occluders, horizontal information only); pt: the same rooms and "
                               "motions path traced by Mitsuba 3 (people of boxes, three bounces; needs "
                               "pip install 'wallcli[pt]'; slow on a CPU, meant for a GPU); mixed (--dataset only): room "
@@ -87,7 +87,8 @@ def simulate(
                                            "video's space-time plots (PNG)."),
     json_out: bool = typer.Option(False, "--json", help="Print the ground truth (without per-frame positions) as JSON on stdout; "
                                   "with --dataset, a summary with the measured windows/s."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP + " With --dataset: rebuild every shard."),
+    force: bool = typer.Option(False, "--force", help=force_help("OUTPUT, its .json ground truth and the --preview file")
+                       + " With --dataset: rebuild every shard."),
     dataset: Optional[int] = number_option(None, "--dataset", lo=1, hi=10_000_000, integer=True, help="Dataset mode: write N labelled 256-frame windows "
                                           "(shards of .npz + dataset.json) to the -o folder instead of one video."),
     task: str = typer.Option("count", "--task", help="Dataset labels: count (0/1/2 people, every activity, mixed pairs) or "
@@ -205,6 +206,12 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
         tmp_truth.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
         _finish(output, tmp_video, sidecar, truth, preview, json_out, force)
+    from wallcli.cli.output import wrote
+    from wallcli.wording import label_text
+
+    who = label_text(truth["people"]) + (f", {truth['activity']}" if truth["people"] else "")
+    wrote((output, f"{n} frames at {fps:g} fps, {w}x{h} pixels, {who}, seed {seed}"), (sidecar, "its ground truth"),
+          (preview, "the room from above beside the space-time plots"))
 
 
 def _finish(output, tmp_video, sidecar, truth, preview, json_out, force) -> None:

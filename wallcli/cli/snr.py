@@ -1,5 +1,5 @@
 """``wallcli snr``: how much wall signal a video carries, where, and how it grows with averaging;
-or, with ``--predict``, what the physics of seed §3 expects for a scene and camera."""
+or, with ``--predict``, what the physics of the paper (supplementary §3.1) expects for a scene and camera."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, THREADS_HELP, Number, number_option, threads_option
+from wallcli.cli.common import THREADS_HELP, Number, force_help, number_option, threads_option
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
 # checks the option and every value of a --sweep alike.
@@ -42,11 +42,11 @@ def _predict_option(name: str):
 
 def snr(
     input: Optional[str] = typer.Argument(None, help="Video file, http(s)/rtsp URL, or '-' (not needed with --predict).", show_default=False),
-    roi: Optional[str] = typer.Option(None, "--roi", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
+    roi: Optional[str] = typer.Option(None, "--roi", metavar="X,Y,W,H|auto", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
                                       "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
                                       "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
                                       "covariances). 'auto' reads the file twice. Default: whole frame."),
-    json_out: bool = typer.Option(False, "--json", help="Print one JSON object (CONTRACT.md fields, plus extras) on stdout."),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object (docs/contract.md fields, plus extras) on stdout."),
     heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
@@ -54,7 +54,7 @@ def snr(
     max_pixels: int = number_option(32768, "--max-pixels", lo=0, hi=2**31, integer=True, help="Pixels measured per frame: a larger ROI is sampled by a regular "
                                    "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
                                    "decode speed). 0 = every pixel of the ROI (exact, slower)."),
-    predict_mode: bool = typer.Option(False, "--predict", help="Predict from the scene's physics (seed §3.1) instead of measuring a video."),
+    predict_mode: bool = typer.Option(False, "--predict", help="Predict from the scene's physics (the paper's supplementary §3.1) instead of measuring a video."),
     approx: bool = typer.Option(False, "--approx", help="--predict: far-field coverage A/(pi d^2) instead of the exact r^2/(r^2+d^2)."),
     sweep: Optional[str] = typer.Option(None, "--sweep", help="--predict: NAME=start:stop:step over any parameter, e.g. distance=1:4:0.25 "
                                         "(names: " + ", ".join(k.replace("_", "-") for k in PREDICT_PARAMS) + ")."),
@@ -72,10 +72,11 @@ def snr(
     bits: int = _predict_option("bits"),
     pixels: float = _predict_option("pixels"),
     frames: float = _predict_option("frames"),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
-    """Measure the wall signal and the noise in a video (seed §4), per colour channel.
+    """Measure the wall signal and the noise in a video, per colour channel (Sharma et al., What
+    You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §3.2).
 
     V is the video with each pixel's temporal mean removed and T(V) is V one frame later. The
     signal is slow and frame noise independent, so noise power = 1/2 Var(V - T(V)), signal power
@@ -115,12 +116,13 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     import warnings
 
     from wallcli.cli.common import parse_roi
-    from wallcli.cli.output import emit_json, print_table, progress, warn
+    from wallcli.cli.output import emit_json, print_table, progress, warn, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.snr import GridAccumulator, SnrAccumulator, snr_db, snr_report
+    from wallcli.wording import format_db
 
     auto = roi is not None and roi.strip().lower() == "auto"
     roi_t = None if auto else parse_roi(roi)
@@ -169,6 +171,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         from wallcli.plots.snr import save_scales_png
 
         save_scales_png(plot, result, force=force)
+    wrote((heatmap, f"{heatmap_of} per cell of the wall"), (plot, "SNR and noise against block size"))
     if json_out:
         emit_json(result)
         return
@@ -178,14 +181,17 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
         "powers in 8-bit code values^2",
-        ["block", "signal R / G / B", "noise R / G / B", "SNR dB R / G / B"],
+        ["block", "signal R G B", "noise R G B", "block SNR dB R G B"],
         [[f"{s['block']}x{s['block']}", _triple(s["signal_power"]), _triple(s["noise_power"]),
-          _triple(s["snr_db"], "{:.1f}")] for s in result["scales"]],
+          _triple(s["snr_db"], format_db, 5)] for s in result["scales"]],
     )
 
 
-def _triple(v, fmt: str = "{:.4g}") -> str:
-    return " / ".join("-" if x is None or x != x else fmt.format(x) for x in v)
+def _triple(v, fmt=None, width: int = 7) -> str:
+    # three significant digits in fixed-width fields keep three channels of three quantities in
+    # aligned columns within 80 characters; the JSON has every digit
+    fmt = fmt or (lambda x: "-" if x is None or x != x else f"{x:.3g}")
+    return " ".join(fmt(x).rjust(width) for x in v)
 
 
 # ------------------------------------------------------------------------------------- predict
@@ -248,8 +254,8 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
         if json_out:
             emit_json({"mode": "predict", "parameters": settings, **out})
             return
-        print_table("snr --predict (seed §3.1)" + (", far-field approximation" if approx else ""),
-                    ["quantity", "value"], [[k, f"{v:.6g}" if v is not None else "-"] for k, v in out.items()])
+        print_table("snr --predict (Sharma et al., ICCV 2021, supplementary §3.1)" + (", far-field approximation" if approx else ""),
+                    ["quantity", "value"], [[k, _shown(k, v)] for k, v in out.items()])
         if params["mean_code"] is None:
             warn("no camera model: give --mean-code and --gain for noise power and SNR")
         return
@@ -265,6 +271,9 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
         from wallcli.plots.snr import save_sweep_png
 
         save_sweep_png(plot, key, rows, force=force)
+        from wallcli.cli.output import wrote
+
+        wrote((plot, f"predicted SNR against {key.replace('_', '-')}"))
     if json_out:
         emit_json({"mode": "predict", "parameters": settings, "sweep": {"parameter": key.replace("_", "-"), "values": values},
                    "rows": rows})
@@ -272,4 +281,13 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
     cols = [key.replace("_", "-"), "theta", "amplitude", "signal_power"] + (
         ["noise_power", "snr_db"] if "noise_power" in rows[0] else [])
     print_table(f"snr --predict, sweeping {key.replace('_', '-')}", cols,
-                [[f"{r[c]:.6g}" if c in r and r[c] is not None else "-" for c in [key] + cols[1:]] for r in rows])
+                [[_shown(c, r.get(c)) for c in [key] + cols[1:]] for r in rows])
+
+
+def _shown(name: str, value) -> str:
+    """A predicted quantity for the table: dB as every output writes dB, the rest to 6 digits."""
+    from wallcli.wording import format_db
+
+    if value is None:
+        return "-"
+    return format_db(value) if name.endswith("_db") else f"{value:.6g}"

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import FORCE_HELP, ROI_HELP, THREADS_HELP, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
@@ -24,7 +24,7 @@ def stplot(
                                           "range per code value, full scale = +-0.5/gain code values (default: automatic, "
                                           "+-3 robust sigma of the signal fill the range)."),
     json_out: bool = typer.Option(False, "--json", help="Print a metadata summary as JSON on stdout."),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the -o and --png files")),
     threads: int = threads_option(THREADS_HELP),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
@@ -63,6 +63,10 @@ def stplot(
             plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)
     with committed_together():  # the .npz, the PNG and the JSON: all or none
         _write(plot, input, output, png, style, gain, json_out, force)
+    from wallcli.cli.output import wrote
+
+    shape = f"{plot.bins} positions x {plot.frames} frames"
+    wrote((output, f"horizontal and vertical space-time plots, {shape}"), (png, "both plots, amplified"))
 
 
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:

@@ -7,7 +7,7 @@ from typing import List, Optional
 
 import typer
 
-from wallcli.cli.common import number_option, threads_option
+from wallcli.cli.common import force_help, number_option, threads_option
 
 INSTALL_HINT = "pip install torch==2.13.0 && pip install 'wallcli[train]'"
 
@@ -58,9 +58,9 @@ def train(
                                       "in units of the window's frame-to-frame noise, asinh-compressed, so a faint "
                                       "second mover is not scaled away by a strong first; v3 = v1 after the whole-wall light change (flicker, "
                                       "drift) is projected out of every sample (wallcli/signal/window.py)."),
-    arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the seed's nets exactly (count reads the "
+    arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the paper's nets exactly (Sharma et al., ICCV 2021, supplementary §2) (count reads the "
                              "horizontal plot, activity both); 'lite' = both plots for either task, time averaged in "
-                             "pairs and 32 channels (about a quarter of the seed count net's work; wallcli/train/nets.py)."),
+                             "pairs and 32 channels (about a quarter of the paper's count net's work; wallcli/train/nets.py)."),
     balance: bool = typer.Option(False, "--balance", help="Weight the loss by the inverse frequency of each class "
                                  "among the training windows (rare classes count as much as common ones)."),
     calibrate: List[Path] = typer.Option([], "--calibrate", help="Simulated validation dataset(s) the net never trained "
@@ -71,13 +71,13 @@ def train(
                                            "how often a decided answer must have been right in calibration."),
     init: Optional[Path] = typer.Option(None, "--init", help="Start from the weights of an exported model of the same "
                                         "task (its .onnx, float or int8): fine-tuning. The card records which."),
-    lr: float = number_option(1e-3, "--lr", lo=1e-7, hi=1, help="RMSProp learning rate (the seed's 1e-3; "
+    lr: float = number_option(1e-3, "--lr", lo=1e-7, hi=1, help="RMSProp learning rate (the paper's 1e-3; "
                              "--anneal ends at 1/100 of it). Lower it to fine-tune from --init."),
     device: str = typer.Option("cpu", "--device", help="Where the net trains: 'cpu', or 'cuda' on a machine with an "
                                "NVIDIA GPU and a CUDA build of PyTorch (batches are still read and augmented on the CPU)."),
-    force: bool = typer.Option(False, "--force", help="Overwrite OUT and its card."),
+    force: bool = typer.Option(False, "--force", help=force_help("OUT and its card")),
 ) -> None:
-    """Train the seed's CNN on simulator windows and export it to ONNX with a model card.
+    """Train the paper's CNN on simulator windows and export it to ONNX with a model card.
 
     RMSProp (lr 1e-3) on cross-entropy, with label-preserving augmentation. A checkpoint is
     written every few minutes and after each epoch; running the same command again (or after

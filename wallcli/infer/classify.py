@@ -31,10 +31,12 @@ def _too_short(source: str, frames: int, model) -> WallcliError:
 
 def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> dict[str, Any]:
     k = int(np.argmax(probs))
+    # judged on the figure the JSON carries, so that the reason quotes exactly that figure
+    signal_db = round(float(signal_db), 2)
     confident, reason = judge(model.card.get("confidence"), probs, signal_db, model.classes)
     return {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
             "label": model.classes[k], "probabilities": [float(p) for p in probs],
-            "confident": confident, "reason": reason, "signal_db": round(float(signal_db), 2)}
+            "confident": confident, "reason": reason, "signal_db": signal_db}
 
 
 def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
@@ -49,11 +51,11 @@ def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
 
 
 def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict[str, Any]:
-    """The CONTRACT.md result from window start times, their probabilities (n, classes) and
+    """The docs/contract.md result from window start times, their probabilities (n, classes) and
     measured signals (n,) in dB."""
     clip = probs.mean(axis=0)
     clip = clip / clip.sum()
-    clip_db = float(np.mean(signal_db))
+    clip_db = round(float(np.mean(signal_db)), 2)
     confident, reason = judge(model.card.get("confidence"), clip, clip_db, model.classes)
     return {
         "input": source,
@@ -65,7 +67,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict
         "probabilities": [float(p) for p in clip],
         "confident": confident,
         "reason": reason,
-        "signal_db": round(clip_db, 2),
+        "signal_db": clip_db,
         "stride": int(stride),
         "window": model.window,
         "windows": [_window_record(model, t, pr, db) for t, pr, db in zip(times, probs, signal_db)],
@@ -73,7 +75,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict
 
 
 def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
-    """The CONTRACT.md result for a whole space-time plot (a .npz file, already in memory)."""
+    """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
     plots, grid = resampled_plots(model, plot)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
@@ -128,7 +130,7 @@ class WindowClassifier:
             self._emitted = self.windower.count
 
     def result(self, source: str) -> dict[str, Any]:
-        """The CONTRACT.md result; WallcliError when the stream was shorter than one window."""
+        """The docs/contract.md result; WallcliError when the stream was shorter than one window."""
         model, w = self.model, self.windower
         last = w.last()
         if last is None:

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from wallcli.wording import format_db, label_text
+
 FORMAT = "wallcli.confidence v1"
 MIN_SUPPORT = 25  # validation windows a threshold must rest on
 NO_BLOCK_REASON = "the model card states no validated confidence thresholds"
@@ -113,11 +115,13 @@ def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]
     t = block["thresholds"][b][k]
     level = block["level"]
     label = classes[k]
-    what = (f"{label} person" if label == 1 else f"{label} people") if isinstance(label, int) else str(label)
+    what = label_text(label)
+    # 'signal' names the figure: the window's signal_db, not the per-pixel SNR of `wallcli snr`
     if t is None:
-        return False, f"'{what}' at {snr_db:.0f} dB: never {level:.0%} right in validation ({_band_text(edges, b)})"
+        return False, (f"'{what}' at signal {format_db(snr_db)} dB: never {level:.0%} right in validation "
+                       f"({_band_text(edges, b)})")
     if probs[k] < t:
-        return False, f"p={probs[k]:.3f} for '{what}' at {snr_db:.0f} dB; {level:.0%} right only from p={t:.3f}"
+        return False, f"p={probs[k]:.3f} for '{what}' at signal {format_db(snr_db)} dB; {level:.0%} right only from p={t:.3f}"
     return True, None
 
 

@@ -80,13 +80,28 @@ class Planes:
 
         Clipping would bias averages of values near black or white, so out-of-gamut stays as is.
         """
+        return self._rgb64(y, u, v).astype(np.float32)
+
+    def rgb_affine(self, chroma: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """(M (3, 3), b (3,)), float64, with RGB = [y, u, v] @ M + b: :meth:`to_rgb` as one affine
+        map, for callers that convert many small arrays (a frame's profiles) and would otherwise
+        pay its dozen numpy steps each time. ``chroma=False``: from y alone (rows 1-2 of M zero)."""
+        points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+        if chroma and self.u is not None:
+            out = self._rgb64(points[:, 0], points[:, 1], points[:, 2])
+        else:
+            out = np.concatenate([self._rgb64(points[:2, 0]), np.zeros((2, 3))])
+            out[2:] = out[0]
+        return out[1:] - out[0], out[0]
+
+    def _rgb64(self, y, u=None, v=None) -> np.ndarray:
         scale = float(1 << (self.depth - 8))
         y = np.asarray(y, dtype=np.float64) / scale
         if self.kind == "rgb":
-            return np.stack([y, np.asarray(u) / scale, np.asarray(v) / scale], axis=-1).astype(np.float32)
+            return np.stack([y, np.asarray(u, np.float64) / scale, np.asarray(v, np.float64) / scale], axis=-1)
         if self.kind == "gray" or u is None:
             yy = y if self.full_range else (y - 16.0) * (255.0 / 219.0)
-            return np.repeat(yy[..., None], 3, axis=-1).astype(np.float32)
+            return np.repeat(yy[..., None], 3, axis=-1)
         u = np.asarray(u, dtype=np.float64) / scale - 128.0
         v = np.asarray(v, dtype=np.float64) / scale - 128.0
         if self.full_range:
@@ -98,7 +113,7 @@ class Planes:
         r = yy + 2.0 * (1.0 - kr) * cr
         b = yy + 2.0 * (1.0 - kb) * cb
         g = (yy - kr * r - kb * b) / kg
-        return np.stack([r, g, b], axis=-1).astype(np.float32)
+        return np.stack([r, g, b], axis=-1)
 
     def rgb(self) -> np.ndarray:
         """The whole frame as float32 RGB (H, W, 3), chroma upsampled bilinearly, no rounding."""

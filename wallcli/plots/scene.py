@@ -38,7 +38,9 @@ def draw_room(ax, truth: dict) -> None:
     ax.set_xlabel("x along the wall (m)")
     ax.set_ylabel("distance from the wall (m)")
     ax.legend(fontsize=7, loc="lower right")
-    ax.set_title(f"{truth['people']} people, {truth['activity']}; seed {truth['seed']}\n(o start, \u25a1 end)", fontsize=9)
+    from wallcli.wording import label_text
+
+    ax.set_title(f"{label_text(truth['people'])}, {truth['activity']}; seed {truth['seed']}\n(o start, \u25a1 end)", fontsize=9)
 
 
 def save_preview(path, truth: dict, plot, *, force: bool = False) -> None:

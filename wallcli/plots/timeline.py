@@ -23,9 +23,11 @@ def save_timeline_png(path, result: dict, plot, *, force: bool = False) -> None:
     ax_p.set_ylim(-0.02, 1.02)
     ax_p.set_ylabel("probability")
     ax_p.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, title=result["task"])
-    best = max(result["probabilities"])
-    ax_p.set_title(f"{result['input']}: {result['task']} = {result['label']} (p={best:.2f}, mean of "
-                   f"{len(wins)} windows)", fontsize=10, loc="left")
+    # the answer as the table and the report state it: an undetermined one is not titled as decided
+    from wallcli.wording import answer_text
+
+    ax_p.set_title(f"{result['input']}: {result['task']} = {answer_text(result)}, mean of {len(wins)} "
+                   f"window{'' if len(wins) == 1 else 's'}", fontsize=10, loc="left")
     g = auto_gain(plot)
     roi = plot.meta.get("roi") or [0, 0, plot.bins, plot.bins]
     extent = (float(plot.time[0]), float(plot.time[-1]), roi[0] + roi[2], roi[0])

@@ -1,7 +1,7 @@
 """Everything a clip's report shows, from one decode of the video.
 
 The frames go once through :func:`wallcli.signal.stplot.compute_stplot`; on their way they also
-feed the SNR estimators of ``wallcli snr`` (seed §3.2) and leave their first frame for the
+feed the SNR estimators of ``wallcli snr`` (paper suppl. §3.2) and leave their first frame for the
 picture. count and activity then read the finished plot exactly as ``wallcli count plots.npz``
 does (``classify_plot``), so no second decode is needed. Memory is that of ``wallcli stplot``:
 the two plots, 1.5 KB per frame at 64 bins; frames themselves are streamed.
@@ -34,7 +34,7 @@ class ClipAnalysis:
     grid: Any  # wallcli.signal.snr.GridAccumulator
     frame: np.ndarray  # the first decoded frame, RGB float32 0-255
     models: dict[str, Any]  # task -> wallcli.infer.model.Model
-    results: dict[str, dict] = field(default_factory=dict)  # task -> CONTRACT.md result
+    results: dict[str, dict] = field(default_factory=dict)  # task -> docs/contract.md result
     failures: dict[str, str] = field(default_factory=dict)  # task -> why it has no verdict
     warnings: list[str] = field(default_factory=list)
 

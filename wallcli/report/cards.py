@@ -48,7 +48,19 @@ def _figure(block: dict, name: str) -> dict[str, Any]:
     }
 
 
-_TRANSFER_KNOWN = ("dir", "dataset", "set", "accuracy", "ci95", "accuracy_95ci", "clips", "scored", "coverage",
+def set_name(block: dict, fallback: str) -> str:
+    """A data set as a reader knows it: the card's description, else what its recipe says (domain,
+    windows), never the folder it sat in on the machine that trained the model."""
+    if isinstance(block.get("description"), str) and block["description"].strip():
+        return block["description"]
+    recipe = block.get("recipe") if isinstance(block.get("recipe"), dict) else {}
+    domain, windows = recipe.get("domain"), block.get("windows") or recipe.get("windows")
+    if isinstance(domain, str) and isinstance(windows, int) and not isinstance(windows, bool):
+        return f"{fallback}: {domain} rooms, {windows:,} windows"
+    return fallback
+
+
+_TRANSFER_KNOWN = ("dir", "dataset", "set", "description", "accuracy", "ci95", "accuracy_95ci", "clips", "scored", "coverage",
                    "accuracy_decided", "decided", "command", "note")
 
 
@@ -63,11 +75,12 @@ def _transfer(block: Any) -> list[dict[str, Any]] | None:
         # figures this page does not know by name are still shown, as they are written
         other = {str(k): v for k, v in b.items() if k not in _TRANSFER_KNOWN and isinstance(v, (str, int, float, bool))}
         out.append({
-            "set": b.get("dir") or b.get("dataset") or b.get("set"),
+            "set": set_name(b, "transfer set"),
             "accuracy": _num(b.get("accuracy")), "ci": _ci(b.get("ci95") or b.get("accuracy_95ci")),
             "clips": b.get("scored") if b.get("scored") is not None else b.get("clips"),
             "coverage": _num(b.get("coverage")), "accuracy_decided": _num(b.get("accuracy_decided")),
-            "command": b.get("command") if isinstance(b.get("command"), str) else None,
+            # a command naming a folder of the card's author would point the reader at nothing
+            "command": b.get("command") if isinstance(b.get("command"), str) and not b.get("dir") else None,
             "note": b.get("note") if isinstance(b.get("note"), str) else None,
             "other": other,
         })
@@ -80,10 +93,10 @@ def model_summary(model) -> dict[str, Any]:
     source = v.get("source") if isinstance(v.get("source"), dict) else {}
     sets = []
     if v:
-        sets.append(_figure(v, str(source.get("dataset") or "validation set")))
+        sets.append(_figure(v, set_name({**source, "windows": v.get("windows")}, "simulated validation set")))
         for o in v.get("other_sets") or []:
             if isinstance(o, dict):
-                sets.append(_figure(o, str(o.get("dataset") or "another validation set")))
+                sets.append(_figure(o, set_name(o, "another simulated validation set")))
     by_snr = []
     for row in v.get("accuracy_by_snr") or []:
         if isinstance(row, dict) and isinstance(row.get("snr_db"), list) and len(row["snr_db"]) == 2:

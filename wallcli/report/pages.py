@@ -24,7 +24,7 @@ def _task_view(task: str, result: dict | None, failure: str | None, figure: str 
     windows = []
     for w in result.get("windows", []):
         windows.append({"start": w.get("start"), "end": w.get("end"), "answer": answer(task, w),
-                        "probabilities": list(w.get("probabilities") or [])})
+                        "signal_db": w.get("signal_db"), "probabilities": list(w.get("probabilities") or [])})
     return {"task": task, "result": result, "failure": None, "figure": figure, "windows": windows,
             "classes": classes, "clip": answer(task, result), "probabilities": list(result.get("probabilities") or []),
             "undetermined": sum(not w["answer"]["decided"] for w in windows)}

@@ -20,7 +20,7 @@ def environment():
 
     env = Environment(loader=PackageLoader("wallcli.report", "templates"), autoescape=True,
                       undefined=StrictUndefined, trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
-    env.filters.update(pct=pct, num=num, ci=ci, nbytes=nbytes, hms=hms)
+    env.filters.update(pct=pct, num=num, ci=ci, nbytes=nbytes, hms=hms, db=db)
     return env
 
 
@@ -60,6 +60,13 @@ def _finite(x) -> bool:
 
 def num(x, fmt: str = "{:.3g}", missing: str = "—") -> str:
     return fmt.format(x) if _finite(x) else missing
+
+
+def db(x, missing: str = "—") -> str:
+    """A dB figure as every other output writes it (one decimal, never -0.0)."""
+    from wallcli.wording import format_db
+
+    return format_db(x) if _finite(x) else missing
 
 
 def pct(x, digits: int = 1) -> str:

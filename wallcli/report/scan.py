@@ -1,4 +1,4 @@
-"""The summary of a ``wallcli scan`` run: its JSON Lines (CONTRACT.md), one row per video.
+"""The summary of a ``wallcli scan`` run: its JSON Lines (docs/contract.md), one row per video.
 
 A scan writes and flushes one line per video as it finishes, so a killed scan leaves a file
 whose last line may be cut short; a line that is not a JSON object becomes a row carrying that
@@ -54,19 +54,20 @@ def read_results(path: str | Path) -> tuple[list[dict[str, Any]], list[str]]:
 
 
 def snr_figure(snr: Any) -> float | None:
-    """One SNR per video: per pixel (seed §3.2), of R, G and B together (their powers averaged)."""
-    from wallcli.signal.snr import snr_db
-
+    """The video's pixel SNR on the green channel: ``snr.snr_db[1]`` of its results line, as it is
+    there (a figure computed here, as the RGB mean once was, matched no number in the results)."""
     if not isinstance(snr, dict):
         return None
-    sig, noi = snr.get("signal_power"), snr.get("noise_power")
-    if isinstance(sig, list) and isinstance(noi, list) and sig and len(sig) == len(noi) \
-            and all(_num(x) is not None for x in sig + noi):
-        return float(snr_db(np.mean(sig), np.mean(noi)))
-    db = snr.get("snr_db")
-    if isinstance(db, list) and db and all(_num(x) is not None for x in db):
-        return float(np.mean(db))
-    return None
+    db, channels = snr.get("snr_db"), snr.get("channels")
+    if not isinstance(db, list) or not db:
+        return None
+    g = channels.index("g") if isinstance(channels, list) and "g" in channels else min(1, len(db) - 1)
+    return _num(db[g]) if g < len(db) else None
+
+
+def _signal(obj: Any) -> float | None:
+    """A task's signal_db: the analysed windows' signal over the plot's noise, its answer judged on it."""
+    return _num(obj.get("signal_db")) if isinstance(obj, dict) else None
 
 
 def _row(rec: dict[str, Any]) -> dict[str, Any]:
@@ -82,6 +83,7 @@ def _row(rec: dict[str, Any]) -> dict[str, Any]:
         "size": size if isinstance(size, int) and not isinstance(size, bool) else None,
         "sha256": rec.get("sha256") if isinstance(rec.get("sha256"), str) else None,
         "snr_db": snr_figure(rec.get("snr")),
+        "signal_db": {t: _signal(rec.get(t)) for t in TASKS},
         "count": tasks["count"], "activity": tasks["activity"],
         "confident": confident, "error": error,
     }
@@ -102,8 +104,10 @@ def summarise(records: list[dict[str, Any]]) -> dict[str, Any]:
             "duration": sum(r["duration"] or 0.0 for r in ok),
             "frames": int(sum(r["frames"] or 0 for r in ok)),
             "size": sum(r["size"] or 0 for r in rows),
-            "confident": sum(r["confident"] is True for r in ok),
-            "undetermined": sum(r["confident"] is False for r in ok),
+            # per task: activity may be decided on videos whose count is not (one figure for both,
+            # 'decided 0 / undetermined 9', hid activity's 6 decided answers)
+            "answered": {t: sum(r[t] is not None for r in ok) for t in TASKS},
+            "decided": {t: sum(r[t] is not None and r[t]["decided"] for r in ok) for t in TASKS},
             "count": tally("count"), "activity": tally("activity"),
         },
     }

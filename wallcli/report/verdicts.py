@@ -1,6 +1,6 @@
 """Clip and window answers as a page states them: the label, or ``undetermined (reason)``.
 
-``confident`` and ``reason`` (CONTRACT.md) are read with ``.get``: results written before they
+``confident`` and ``reason`` (docs/contract.md) are read with ``.get``: results written before they
 existed carry neither, and then the answer is shown as it is, with its confidence unknown.
 """
 from __future__ import annotations
@@ -9,9 +9,9 @@ from typing import Any
 
 
 def label_text(task: str | None, label: Any) -> str:
-    if task == "count" and isinstance(label, int) and not isinstance(label, bool):
-        return f"{label} {'person' if label == 1 else 'people'}"
-    return str(label)
+    from wallcli.wording import label_text as words
+
+    return words(label) if task == "count" else str(label)
 
 
 def answer(task: str | None, obj: Any) -> dict[str, Any]:

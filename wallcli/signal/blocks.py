@@ -111,6 +111,10 @@ def _coverage(origin: int, n: int, edges: np.ndarray) -> np.ndarray:
     return overlap / np.diff(e)[:, None]
 
 
+def _fast_sums_fit(sub: np.ndarray) -> bool:
+    return sub.dtype == np.uint8 and max(sub.shape) * 255 < (1 << 24)
+
+
 class ProjectionPlan:
     """Exact means over a rectangle of one plane, binned two ways (see :func:`projection_means`).
 
@@ -125,10 +129,31 @@ class ProjectionPlan:
         self.ci0, self.ci1 = int(np.floor(self.c0)), int(np.ceil(self.c1))
         self.col_bins = _coverage(self.ci0, self.ci1 - self.ci0, col_edges) / (self.r1 - self.r0)
         self.row_bins = _coverage(self.ri0, self.ri1 - self.ri0, row_edges) / (self.c1 - self.c0)
+        # decided on the first plane: 8-bit and a rectangle of whole pixels (see _fast_call)
+        self._fast = None if (self.r0, self.r1, self.c0, self.c1) == (self.ri0, self.ri1, self.ci0, self.ci1) else False
+        self._col_sums = np.empty((1, self.ci1 - self.ci0), np.float32)
+        self._row_sums = np.empty((self.ri1 - self.ri0, 1), np.float32)
+
+    def _fast_call(self, sub: np.ndarray, rows: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        """The common case (8-bit plane, whole-pixel rectangle): OpenCV sums into buffers made
+        once, straight into the binning products; no per-frame arrays but the (bins,) results.
+        float32 holds these sums exactly (each under 2^24, checked in _fast_sums_fit)."""
+        import cv2
+
+        cv2.reduce(sub, 0, cv2.REDUCE_SUM, dst=self._col_sums, dtype=cv2.CV_32F)
+        col = self.col_bins @ self._col_sums[0]
+        if not rows:
+            return col, None
+        cv2.reduce(sub, 1, cv2.REDUCE_SUM, dst=self._row_sums, dtype=cv2.CV_32F)
+        return col, self.row_bins @ self._row_sums[:, 0]
 
     def __call__(self, plane: np.ndarray, rows: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """(column-bin means, row-bin means); ``rows=False`` skips the second reduction (None)."""
         sub = plane[self.ri0:self.ri1, self.ci0:self.ci1]
+        if self._fast is None:
+            self._fast = _fast_sums_fit(sub)
+        if self._fast:
+            return self._fast_call(sub, rows)
         col = _line_sums(sub, 0)
         if self.r0 > self.ri0:
             col -= (self.r0 - self.ri0) * sub[0].astype(np.float64)
@@ -191,16 +216,28 @@ class RgbProjector:
             cv2.setNumThreads(threads)
 
     def _project(self, planes) -> tuple[np.ndarray, np.ndarray]:
-        key = (planes.u is None, planes.sub_x, planes.sub_y)
+        key = (planes.u is None, planes.sub_x, planes.sub_y, planes.kind, planes.depth, planes.matrix,
+               planes.full_range)
         if key != self._key:
             self._key = key
             self._luma = ProjectionPlan(self.rows, self.cols)
             self._chroma = ProjectionPlan(self.rows / (1 << planes.sub_y), self.cols / (1 << planes.sub_x))
+            # to_rgb as one affine map: its dozen numpy steps on (bins,) arrays cost more than the
+            # reductions themselves (bench/RESULTS.md, issue 28)
+            self._m, self._b = planes.rgb_affine()
+            self._yuv = np.zeros((2, len(self.cols) - 1, 3))
         v = self.vertical
-        yc, yr = self._luma(planes.y, v)
-        if planes.u is None:
-            return planes.to_rgb(yc).astype(np.float64), (planes.to_rgb(yr).astype(np.float64) if v else self._zeros)
-        uc, ur = self._chroma(planes.u, v)
-        vc, vr = self._chroma(planes.v, v)
-        return (planes.to_rgb(yc, uc, vc).astype(np.float64),
-                planes.to_rgb(yr, ur, vr).astype(np.float64) if v else self._zeros)
+        yuv = self._yuv
+        yuv[0, :, 0], r = self._luma(planes.y, v)
+        if v:
+            yuv[1, :, 0] = r
+        if planes.u is not None:
+            yuv[0, :, 1], r = self._chroma(planes.u, v)
+            if v:
+                yuv[1, :, 1] = r
+            yuv[0, :, 2], r = self._chroma(planes.v, v)
+            if v:
+                yuv[1, :, 2] = r
+        # float32 as to_rgb gives: the rows stored downstream are float32 anyway
+        rgb = (yuv[: 2 if v else 1] @ self._m + self._b).astype(np.float32).astype(np.float64)
+        return rgb[0], (rgb[1] if v else self._zeros)

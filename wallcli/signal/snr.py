@@ -1,4 +1,4 @@
-"""Signal and noise of a wall video (seed notes §4) and their prediction from physics (§3).
+"""Signal and noise of a wall video (Sharma et al. 2021, supplementary §3.2) and their prediction from physics (§3.1).
 
 Estimator. V is the video with each pixel's temporal mean removed and T shifts it by one frame.
 The signal is slow, so V - T(V) is (almost) noise alone and frame noise is independent:
@@ -341,7 +341,7 @@ class FrameSnr:
 
 
 def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, notes=()) -> dict:
-    """The object of ``wallcli snr --json`` (CONTRACT.md) from a fed accumulator.
+    """The object of ``wallcli snr --json`` (docs/contract.md) from a fed accumulator.
 
     One builder for ``wallcli snr`` and ``wallcli scan`` (which feeds the accumulator from the
     decode that also makes the space-time plots), so both report the same fields.  ``notes``:

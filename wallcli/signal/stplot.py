@@ -1,4 +1,4 @@
-"""Space-time plots (seed notes §1): the wall averaged over rows (horizontal plot) or columns
+"""Space-time plots (Sharma et al. 2021): the wall averaged over rows (horizontal plot) or columns
 (vertical plot), one line per frame, each pixel's temporal mean removed.
 
 Layout: ``horizontal`` and ``vertical`` are float32 arrays (bins, T, 3) = position x time x RGB,

@@ -3,7 +3,7 @@
 Training (simulated clips) and inference (any video) both go through these functions, so the
 model sees at run time exactly what it saw in training.
 
-Decisions (seed notes are silent on them):
+Decisions (the paper is silent on them):
 - Canonical rate 30 fps: 256 samples = 8.533 s. Other rates are resampled by linear
   interpolation on the frames' own timestamps (which also regularises variable frame rates).
   Any clip of >= 8.6 s therefore gives a window, whatever its frame rate.
@@ -13,7 +13,7 @@ Decisions (seed notes are silent on them):
   relative strength of colours and positions.
 - ``normalize_window`` version 2 (``--preprocessing v2`` in training; the card says which one a
   model needs): the same mean removal, then the window in units of its frame-to-frame noise
-  (sigma^2 = half the mean square of the frame differences, seed notes section 4), compressed
+  (sigma^2 = half the mean square of the frame differences, paper suppl. §3.2), compressed
   by asinh. Version 1 lets the strongest mover set the scale, so a second person 20 dB fainter
   but well above the noise comes out tiny; in noise units every mover above the noise is of
   order one or more, and asinh keeps a mover 1000x over the noise within about 8.
@@ -148,7 +148,7 @@ SIGNAL_FLOOR_DB = -30.0
 
 def window_signal_db(parts: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
     """How strong the signal of plot windows is, in dB over their noise, after the whole-wall
-    light changes are removed (seed notes section 4, on the plots).
+    light changes are removed (the estimator of paper suppl. §3.2, on the plots).
 
     ``parts``: [(windows (..., bins, T, 3), offsets (..., bins, 3))], e.g. the horizontal and the
     vertical plot. Noise power = half the mean square of the differences between consecutive

@@ -1,4 +1,4 @@
-"""Flatland (seed notes §5): a 2-D world of a receiver line, an emitter line and 1-2 occluders.
+"""Flatland (Sharma et al. 2021, supplementary §4): a 2-D world of a receiver line, an emitter line and 1-2 occluders.
 
 Geometry: the receiver (the observed wall) is y = 0, x in [0, width]; the emitter (the lighting
 environment) is the line y = depth, x in [x0, x1], split into cells of constant radiance;

@@ -160,7 +160,7 @@ class Scene:
             yield cam.render(dE, i, static_E=E0)
 
     def truth(self, frames: int | None = None) -> dict:
-        """The JSON sidecar: CONTRACT fields plus everything needed to reproduce or study the clip."""
+        """The JSON sidecar: docs/contract.md fields plus everything needed to reproduce or study the clip."""
         n = len(self.times) if frames is None else frames
         persons = []
         for p, a, pose, (c, _, _) in zip(self.people, self.activities, self.poses, self.sphere_tracks()):

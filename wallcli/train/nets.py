@@ -1,4 +1,4 @@
-"""The seed's two CNNs (seed-notes §2), exactly.
+"""The paper's two CNNs (Sharma et al. 2021, supplementary §2), exactly.
 
 Input layout is NCHW = (batch, colour channel, space, time) = (N, 3, 64, 256): the
 space-time plot with channels first, as produced by

@@ -1,0 +1,113 @@
+"""What a user sees in an 80-column terminal: tables that fit, words in the singular where they
+should be, one dB figure written one way, and a line on stderr for every file written."""
+import json
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+
+def _wallcli(*args, cwd=None):
+    env = dict(os.environ, COLUMNS="80", LINES="40")
+    return subprocess.run([sys.executable, "-m", "wallcli", *map(str, args)], capture_output=True, text=True,
+                          timeout=300, env=env, cwd=cwd)
+
+
+@pytest.fixture(scope="module")
+def clip(tmp_path_factory):
+    d = tmp_path_factory.mktemp("terminal")
+    res = _wallcli("simulate", "-o", d / "walk.mp4", "--people", "1", "--activity", "walking", "--seed", "4",
+                   "--size", "96x72", "--duration", "10.5", "--fps", "24", "--preview", d / "walk-room.png")
+    assert res.returncode == 0, res.stderr
+    return d / "walk.mp4", res
+
+
+def test_simulate_says_what_it_wrote(clip):
+    path, res = clip
+    assert res.stdout == ""
+    line = res.stderr.strip()
+    assert line.startswith(f"wrote {path} (") and "1 person, walking" in line
+    assert f"{path.with_suffix('.json')} (its ground truth)" in line and "walk-room.png" in line
+
+
+def _table_lines(out: str) -> list[str]:
+    # the title is one unwrapped line (scripts grep it); the table and its notes are the rest
+    return out.splitlines()[1:]
+
+
+@pytest.mark.parametrize("task", ["count", "activity"])
+def test_tables_fit_80_columns_and_quote_the_json_figures(task, clip):
+    path, _ = clip
+    res = _wallcli(task, path)
+    assert res.returncode == 0, res.stderr
+    lines = _table_lines(res.stdout)
+    assert all(len(line) <= 80 for line in lines), "\n".join(lines)
+    assert "…" not in res.stdout  # nothing truncated
+    header = lines[0]
+    if task == "count":
+        assert header.split()[-6:] == ["0", "people", "1", "person", "2", "people"]
+    else:
+        assert header.split()[-5:] == ["none", "walking", "crouching", "waving", "jumping"]
+    data = json.loads(_wallcli(task, path, "--json").stdout)
+    rows = [line.split() for line in lines[2:2 + len(data["windows"]) + 1]]
+    # the signal column is the JSON's signal_db to one decimal, window by window and for the clip
+    for row, obj in zip(rows, data["windows"] + [data]):
+        assert row[2] == f"{obj['signal_db']:.1f}".replace("-0.0", "0.0")
+        assert row[1] == (str(obj["label"]) if obj["confident"] else "undetermined")
+    if not data["confident"]:
+        # the reason is a note under the table, quoting the same figure
+        assert f"signal {data['signal_db']:.1f} dB" in data["reason"]
+        assert "undetermined: " + data["reason"][:40] in " ".join(res.stdout.split())
+
+
+def test_snr_table_fits_80_columns(clip):
+    path, _ = clip
+    res = _wallcli("snr", path)
+    assert res.returncode == 0, res.stderr
+    assert all(len(line) <= 80 for line in _table_lines(res.stdout))
+    assert "block SNR dB" in res.stdout and "-0.0" not in res.stdout
+
+
+def test_amplify_names_its_grid_as_its_json_does(clip, tmp_path):
+    path, _ = clip
+    res = _wallcli("amplify", path, tmp_path / "amp.mp4", "--json", "--cells", "32")
+    assert res.returncode == 0, res.stderr
+    rows, cols = json.loads(res.stdout)["grid"]
+    assert rows != cols and f"{rows} rows x {cols} columns" in res.stderr
+    assert res.stderr.startswith(f"wrote {tmp_path / 'amp.mp4'} (")
+
+
+def test_format_db_never_writes_minus_zero():
+    from wallcli.wording import format_db
+
+    assert [format_db(x) for x in (-0.04, -0.0, 0.04, 12.345, -3.96, None, float("nan"))] == \
+        ["0.0", "0.0", "0.0", "12.3", "-4.0", "-", "-"]
+
+
+def test_a_reason_quotes_the_figure_it_was_judged_on():
+    from wallcli.infer.confidence import judge
+
+    block = {"level": 0.97, "signal_edges_db": [0.0], "thresholds": [[None, None, None], [0.9, None, None]]}
+    ok, reason = judge(block, [0.2, 0.7, 0.1], -0.04, [0, 1, 2])
+    assert not ok and reason.startswith("'1 person' at signal 0.0 dB:") and not re.search(r"-0(\.0)? dB", reason)
+
+
+def test_the_timeline_figure_is_titled_with_the_answer_the_table_gives(monkeypatch):
+    """An undetermined answer was titled 'count = 1 (p=0.66 …)' in the report's figure."""
+    import numpy as np
+
+    import wallcli.plots.timeline as timeline
+    from wallcli.signal.stplot import StPlot
+
+    titles = []
+    monkeypatch.setattr(timeline, "save_figure", lambda fig, path, force=False: titles.append(fig.axes[0].get_title("left")))
+    t = np.arange(300) / 30
+    plot = StPlot(np.zeros((64, 300, 3), np.float32), np.zeros((64, 300, 3), np.float32), t,
+                  np.full((64, 3), 100, np.float32), np.full((64, 3), 100, np.float32), {"roi": [0, 0, 64, 48]})
+    win = {"start": 0.0, "end": 8.53, "label": 1, "probabilities": [0.1, 0.66, 0.24], "confident": False}
+    result = {"input": "a.mp4", "task": "count", "classes": [0, 1, 2], "label": 1, "probabilities": [0.1, 0.66, 0.24],
+              "confident": False, "reason": "why", "windows": [win]}
+    timeline.save_timeline_png("unused.png", result, plot)
+    assert titles == ["a.mp4: count = undetermined (most likely 1, p=0.66), mean of 1 window"]

@@ -1,0 +1,43 @@
+"""How figures and answers are written for people, the same in tables, reasons and pages.
+
+A decibel figure: one decimal, and never "-0.0". JSON keeps more digits. Every table, reason and page writes this rounding of the JSON's own value,
+so one figure reads the same wherever it appears (a reason saying "19 dB" beside a ``signal_db``
+of 18.6 looked like a second measurement). What each dB figure measures: README, "Which SNR is
+which".
+"""
+from __future__ import annotations
+
+import math
+
+
+def format_db(x) -> str:
+    """``x`` dB as text: '12.3', '0.0' (for -0.04 too), '-' when there is no finite number."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return "-"
+    if not math.isfinite(v):
+        return "-"
+    text = f"{v:.1f}"
+    return "0.0" if text == "-0.0" else text
+
+
+def plural(n: int, word: str, words: str | None = None) -> str:
+    """'1 video', '2 videos' ('1 person', '3 people' with ``words``)."""
+    return f"{n} {word if n == 1 else (words or word + 's')}"
+
+
+def label_text(label) -> str:
+    """An answer as words: count's 1 -> '1 person', 0 -> '0 people'; activity's labels as they are."""
+    if isinstance(label, int) and not isinstance(label, bool):
+        return f"{label} {'person' if label == 1 else 'people'}"
+    return str(label)
+
+
+def answer_text(result: dict) -> str:
+    """A clip's answer as a title states it: '1 (p=0.93)', or 'undetermined (most likely 1, p=0.75)'
+    when it may not be relied upon; the same words under a table and over a figure."""
+    p = max(result["probabilities"])
+    if result.get("confident", True):
+        return f"{result['label']} (p={p:.2f})"
+    return f"undetermined (most likely {result['label']}, p={p:.2f})"
