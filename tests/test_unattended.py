@@ -1,0 +1,186 @@
+"""Issue 29: ways an unattended batch died or lied, one regression test (or a few) per defect.
+(Its items 10 and 11 are evaluate's, tested with evaluate.) Servers and clusters listen on
+127.0.0.1 only and are stopped here."""
+from __future__ import annotations
+
+import contextlib
+import csv
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from clips import write_clip, write_plot
+
+SIM = ["--size", "64x48", "--duration", "10.5", "--fps", "30", "--grid", "16x16", "--crf", "12"]
+WALLCLI = [sys.executable, "-m", "wallcli"]
+
+
+@pytest.fixture(scope="module")
+def video(tmp_path_factory) -> Path:
+    """One short simulated clip (a window fits; a decode takes a fraction of a second)."""
+    from wallcli.cli.app import main
+
+    path = tmp_path_factory.mktemp("video") / "walk.mp4"
+    with pytest.raises(SystemExit) as exit_:
+        main(["simulate", "-o", str(path), "--people", "1", "--activity", "walking", "--seed", "1", *SIM])
+    assert exit_.value.code == 0
+    return path
+
+
+@pytest.fixture
+def clip(tmp_path):
+    """A tiny clip for the commands that fail before they decode."""
+    return write_clip(tmp_path / "c.mkv", lambda i: np.full((24, 32, 3), 120.0) + np.random.default_rng(i).normal(
+        0, 1.0, (24, 32, 3)), 12, fps=30, codec="ffv1", pix_fmt="bgr0", options={})
+
+
+def _one_error(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in err, err
+    assert "internal error" not in lines[0], lines[0]  # a clean line says what is wrong
+    return lines[0]
+
+
+def _copies(folder: Path, video: Path, names) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        shutil.copy(video, os.path.join(os.fsencode(folder), os.fsencode(name)))
+    return folder
+
+
+def _lines(path: Path) -> list[dict]:
+    return [json.loads(s) for s in path.read_text(encoding="utf-8").splitlines()]
+
+
+def _temporaries(folder: Path) -> list[str]:
+    return [p.name for p in folder.iterdir() if ".tmp" in p.name]
+
+
+def _limited(limit_bytes: int):
+    def apply():
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
+    return apply
+
+
+# 1 ------------------------------------------------------------------- outputs that are not files
+@pytest.mark.parametrize("target", ["/dev/full", "/dev/zero", "/dev/null", "fifo"])
+def test_scan_refuses_an_output_that_is_not_a_file_before_reading_it(tmp_path, video, target):
+    if target == "fifo":
+        target = str(tmp_path / "fifo.jsonl")
+        os.mkfifo(target)
+    elif not os.path.exists(target):
+        pytest.skip(f"no {target} here")
+    folder = _copies(tmp_path / "v", video, ["a.mp4"])
+    # in a process of its own, with its memory bounded: before, /dev/zero was read as earlier
+    # results without end, /dev/full too, and a FIFO waited for a writer for ever
+    res = subprocess.run([*WALLCLI, "scan", str(folder), "-o", target, "--workers", "1"], capture_output=True,
+                         text=True, timeout=120, preexec_fn=_limited(3 << 30))
+    line = _one_error(res.stderr)
+    assert res.returncode == 1 and ("is a device" in line or "named pipe" in line) and target in line
+
+
+def test_other_commands_refuse_a_fifo_output_even_with_force(tmp_path, clip, run_cli):
+    fifo = tmp_path / "p.npz"
+    os.mkfifo(fifo)
+    code, out, err = run_cli("stplot", clip, "-o", fifo, "--force")
+    assert code == 1 and out == "" and "named pipe" in _one_error(err)
+    assert Path(fifo).is_fifo()
+
+
+# 2 -------------------------------------------------------------------------- symbolic link loops
+def test_a_symlink_loop_among_the_videos_is_that_videos_error_line(tmp_path, video, run_cli):
+    folder = _copies(tmp_path / "v", video, ["good.mp4"])
+    os.symlink("loop.mp4", folder / "loop.mp4")  # points at itself
+    out = tmp_path / "r.jsonl"
+    code, _, err = run_cli("scan", folder, "-o", out, "--workers", "1")
+    assert code == 0, err
+    lines = {Path(d["input"]).name: d for d in _lines(out)}
+    assert lines["good.mp4"]["error"] is None and lines["good.mp4"]["count"]["label"] in (0, 1, 2)
+    assert "symbolic link" in lines["loop.mp4"]["error"]
+
+
+@pytest.mark.parametrize("command", [["report", "{loop}", "-o", "{tmp}/x.html"], ["stplot", "{loop}", "-o", "{tmp}/x.npz"],
+                                     ["amplify", "{loop}", "{tmp}/x.mp4"], ["snr", "{loop}"]])
+def test_a_symlink_loop_as_the_input_is_one_clean_error(tmp_path, run_cli, command):
+    loop = tmp_path / "loop.mp4"
+    os.symlink(loop.name, loop)
+    code, out, err = run_cli(*(a.format(loop=loop, tmp=tmp_path) for a in command))
+    assert code == 1 and out == "" and "symbolic link" in _one_error(err)
+
+
+@pytest.mark.parametrize("command", [["stplot", "{clip}", "-o", "{loop}.npz"], ["stplot", "{clip}", "-o", "{loop}.npz", "--force"],
+                                     ["report", "{clip}", "-o", "{loop}.html"], ["scan", "{clip}", "-o", "{loop}.jsonl"]])
+def test_a_symlink_loop_as_the_output_is_one_clean_error(tmp_path, clip, run_cli, command):
+    args = [a.format(clip=clip, loop=tmp_path / "loop") for a in command]
+    out_path = Path(args[args.index("-o") + 1])
+    os.symlink(out_path.name, out_path)
+    code, out, err = run_cli(*args)
+    assert code == 1 and out == "" and "symbolic link loop" in _one_error(err)
+    assert out_path.is_symlink() and _temporaries(tmp_path) == []
+
+
+# 7 ----------------------------------------------------- outputs the file system cannot take
+@pytest.mark.parametrize("name", ["n" * 245 + ".jsonl", "n" * 251 + ".npz", "é" * 124 + ".npz", "x." + "s" * 253])
+def test_temporaries_of_long_names_fit_the_file_system(tmp_path, name):
+    from wallcli.io.writer import atomic_path, name_max
+
+    if len(os.fsencode(name)) > name_max(tmp_path):
+        pytest.skip("this file system takes shorter names")
+    with atomic_path(tmp_path / name) as tmp:
+        assert len(os.fsencode(tmp.name)) <= name_max(tmp_path) and tmp.name.startswith(".")
+        tmp.write_text("x")
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+
+
+def test_stplot_to_a_245_character_name(tmp_path, clip, run_cli):
+    out = tmp_path / ("p" * 241 + ".npz")
+    code, _, err = run_cli("stplot", clip, "-o", out)
+    assert code == 0, err
+    assert out.exists() and _temporaries(tmp_path) == []
+    code, _, err = run_cli("stplot", clip, "-o", tmp_path / ("p" * 300 + ".npz"))
+    assert code == 1 and "bytes long" in _one_error(err)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's /proc and /sys")
+@pytest.mark.parametrize("out", ["/proc/wallcli-test.npz", "/sys/wallcli-test.npz"])
+def test_outputs_under_proc_and_sys(clip, run_cli, out):
+    code, stdout, err = run_cli("stplot", clip, "-o", out)
+    assert code == 1 and stdout == "" and _one_error(err)
+
+
+@contextlib.contextmanager
+def _tmpfs(where: Path, options: str):
+    where.mkdir()
+    res = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(where)], capture_output=True)
+    if res.returncode != 0:
+        pytest.skip("cannot mount a file system here (needs root)")
+    try:
+        yield where
+    finally:
+        subprocess.run(["umount", str(where)], check=True)
+
+
+@pytest.mark.skipif(shutil.which("mount") is None, reason="needs mount")
+def test_read_only_and_full_file_systems(tmp_path, clip, run_cli):
+    with _tmpfs(tmp_path / "ro", "ro,size=1m") as ro:
+        for args in (["stplot", clip, "-o", ro / "p.npz"], ["simulate", "--dataset", "2", "--task", "count", "-o", ro / "ds"]):
+            code, _, err = run_cli(*args)
+            assert code == 1 and ("read-only" in _one_error(err) or "not writable" in err)
+    with _tmpfs(tmp_path / "full", "size=64k") as full:
+        (full / "fill").write_bytes(b"\0" * 60_000)
+        code, _, err = run_cli("stplot", clip, "-o", full / "p.npz", "--png", full / "p.png")
+        assert code == 1 and "no space left on device" in _one_error(err)
+        assert sorted(p.name for p in full.iterdir()) == ["fill"]
+
+
