@@ -130,6 +130,104 @@ def test_a_symlink_loop_as_the_output_is_one_clean_error(tmp_path, clip, run_cli
     assert out_path.is_symlink() and _temporaries(tmp_path) == []
 
 
+# 3 ------------------------------------------------------------------------- non-UTF-8 file names
+BAD = os.fsdecode(b"bad\xff\xfename.mp4")
+needs_bytes = pytest.mark.skipif(BAD == "bad\ufffd\ufffdname.mp4", reason="file names here cannot hold undecodable bytes")
+
+
+@needs_bytes
+def test_scan_csv_of_a_non_utf8_name_is_whole_and_resumes(tmp_path, video, run_cli):
+    from wallcli.io.text import unescape_surrogates
+
+    folder = _copies(tmp_path / "v", video, ["a.mp4", os.fsencode(BAD), "z.mp4"])
+    out = tmp_path / "r.csv"
+    code, _, err = run_cli("scan", folder, "-o", out, "--workers", "1")
+    assert code == 0, err
+    with open(out, newline="", encoding="utf-8") as fh:  # strict UTF-8
+        rows = list(csv.DictReader(fh))
+    assert [Path(unescape_surrogates(r["input"])).name for r in rows] == ["a.mp4", BAD, "z.mp4"]
+    assert all(r["error"] == "" for r in rows)
+    assert "bad\\udcff\\udcfename.mp4" in rows[1]["input"]  # escaped as in the JSON Lines
+    before = out.read_bytes()
+    code, stdout, err = run_cli("scan", folder, "-o", out, "--json")
+    assert code == 0 and json.loads(stdout)["skipped"] == 3 and out.read_bytes() == before
+
+
+@needs_bytes
+def test_report_of_results_naming_a_non_utf8_file(tmp_path, run_cli):
+    from wallcli.cli.output import to_json
+
+    results = tmp_path / "r.jsonl"
+    results.write_text(to_json({"input": BAD, "size": 10, "sha256": "0" * 64, "duration": 10.5, "frames": 315,
+                                "tasks": ["snr"], "error": None}) + "\n" +
+                       to_json({"input": "b" + BAD, "tasks": ["snr"], "error": f"{BAD} is not a readable video"}) + "\n")
+    code, _, err = run_cli("report", results, "-o", tmp_path / "index.html")
+    assert code == 0, err
+    page = (tmp_path / "index.html").read_text(encoding="utf-8")
+    assert page.count("bad\\udcff\\udcfename.mp4") >= 3
+
+
+@needs_bytes
+def test_report_of_a_clip_with_a_non_utf8_name(tmp_path, video, run_cli):
+    clip = _copies(tmp_path / "v", video, [os.fsencode(BAD)]) / BAD
+    code, _, err = run_cli("report", clip, "-o", tmp_path / "page.html")
+    assert code == 0, err
+    page = (tmp_path / "page.html").read_text(encoding="utf-8")
+    assert "bad\\udcff\\udcfename.mp4" in page and page.count("data:image/png;base64,") >= 4
+
+
+@needs_bytes
+def test_figures_titled_with_a_non_utf8_name(tmp_path, run_cli):
+    plot = write_plot(tmp_path / os.fsdecode(b"p\xfe.npz"))
+    code, _, err = run_cli("count", plot, "--plot", tmp_path / "t.png")
+    assert code == 0, err
+    assert (tmp_path / "t.png").read_bytes().startswith(b"\x89PNG")
+
+
+# 4 --------------------------------------------------------------------------- CSV quoting rules
+HOSTILE = ["new\nline.mp4", "cr\rname.mp4", "crlf\r\nname.mp4", 'q"uo,te.mp4', "plain.mp4"]
+
+
+def test_csv_records_read_back_whatever_the_names_hold(tmp_path):
+    from wallcli.batch.results import csv_columns, csv_record, flatten, read
+
+    columns = csv_columns(("snr",), {})
+    names = HOSTILE + [os.fsdecode(b"b\xff.mp4")]
+    lines = [{"input": n, "size": 7, "sha256": "0" * 64, "tasks": ["snr"], "error": "x\ny" if i else None}
+             for i, n in enumerate(names)]
+    text = csv_record(columns) + "".join(csv_record(flatten(d, columns)) for d in lines)
+    path = tmp_path / "r.csv"
+    path.write_text(text, encoding="utf-8")
+    entries, torn = read(path, columns)
+    assert [e.input for e in entries] == names and not torn
+    assert [e.error for e in entries] == [None] + ["x\ny"] * (len(names) - 1)
+    assert "".join(e.raw + "\n" for e in entries) == text[len(csv_record(columns)):]  # written back as they were
+    # a kill while a record was written: the whole ones before it are kept, the torn one dropped,
+    # also when the cut falls just after a newline inside a quoted name
+    first = csv_record(columns) + csv_record(flatten(lines[0], columns))
+    path.write_text(first + csv_record(flatten(lines[1], columns))[:3], encoding="utf-8")
+    entries, torn = read(path, columns)
+    assert [e.input for e in entries] == names[:1] and torn
+    path.write_text(first[:first.index("line.mp4")], encoding="utf-8")  # cut just after the quoted newline
+    entries, torn = read(path, columns)
+    assert entries == [] and torn
+
+
+def test_scan_csv_with_newlines_and_quotes_in_names_resumes(tmp_path, video, run_cli):
+    folder = _copies(tmp_path / "v", video, HOSTILE[:4])
+    out = tmp_path / "r.csv"
+    code, _, err = run_cli("scan", folder, "-o", out, "--task", "snr", "--workers", "1")
+    assert code == 0, err
+    with open(out, newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert sorted(Path(r["input"]).name for r in rows) == sorted(HOSTILE[:4])
+    assert all(r["error"] == "" and r["snr.frames"] == "315" for r in rows)
+    before = out.read_bytes()
+    code, stdout, err = run_cli("scan", folder, "-o", out, "--task", "snr", "--json")
+    assert code == 0, err
+    assert json.loads(stdout)["skipped"] == 4 and out.read_bytes() == before
+
+
 # 7 ----------------------------------------------------- outputs the file system cannot take
 @pytest.mark.parametrize("name", ["n" * 245 + ".jsonl", "n" * 251 + ".npz", "é" * 124 + ".npz", "x." + "s" * 253])
 def test_temporaries_of_long_names_fit_the_file_system(tmp_path, name):

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from wallcli.errors import WallcliError
+from wallcli.io.text import escape_surrogates, unescape_surrogates
 
 BASE = ["input", "size", "sha256", "duration", "frames", "tasks", "seconds", "error", "warnings"]
 CHANNELS = ("r", "g", "b")
@@ -57,6 +58,18 @@ def _cell(value: Any) -> str:
     if isinstance(value, (int, float, str)):
         return str(value)
     return json.dumps(value, ensure_ascii=False)  # lists of objects (windows, scales), warnings
+
+
+def csv_record(cells: list[str]) -> str:
+    """One CSV record, newline included, that ``csv.reader`` reads back as ``cells`` whatever they
+    hold: newlines and quotes inside a cell are quoted (a file name may hold them), and a file
+    name's undecodable bytes are escaped as in JSON (a CSV is UTF-8 text)."""
+    buf = io.StringIO()
+    # csv.writer quotes a cell holding the line terminator's characters, but not a bare '\r',
+    # which readers take for a line end: a row holding one is quoted whole
+    quoting = csv.QUOTE_ALL if any("\r" in c for c in cells) else csv.QUOTE_MINIMAL
+    csv.writer(buf, lineterminator="\n", quoting=quoting).writerow(cells)
+    return escape_surrogates(buf.getvalue())
 
 
 def flatten(line: dict, columns: list[str]) -> list[str]:
@@ -103,11 +116,7 @@ def _entry_json(raw: str) -> Entry | None:
     return Entry(raw, d["input"], d.get("size"), d.get("sha256"), tuple(d["tasks"]), d.get("error"))
 
 
-def _entry_csv(raw: str, header: list[str]) -> Entry | None:
-    try:
-        row = next(csv.reader(io.StringIO(raw)))
-    except (csv.Error, StopIteration):
-        return None
+def _entry_csv(row: list[str], header: list[str]) -> Entry | None:
     if len(row) != len(header):
         return None
     d = dict(zip(header, row))
@@ -115,8 +124,45 @@ def _entry_csv(raw: str, header: list[str]) -> Entry | None:
         size = int(d["size"]) if d["size"] else None
     except ValueError:
         return None
-    return Entry(raw, d["input"], size, d["sha256"] or None, tuple(t for t in d["tasks"].split(",") if t),
-                 d["error"] or None)
+    return Entry(csv_record(row)[:-1], unescape_surrogates(d["input"]), size, d["sha256"] or None,
+                 tuple(t for t in d["tasks"].split(",") if t), d["error"] or None)
+
+
+def _not_ours(path: Path, n: int) -> WallcliError:
+    return WallcliError(f"{path} line {n} is not a wallcli scan result",
+                        hint="choose another -o, or --force to replace the file")
+
+
+def _read_csv(path: Path, text: str, columns: list[str]) -> tuple[list[Entry], bool]:
+    """Records by the csv module's rules (a quoted cell may hold newlines), as they were written."""
+    reader = csv.reader(io.StringIO(text, newline=""), strict=True)
+    rows: list[tuple[int, list[str]]] = []
+    torn = False
+    try:
+        for row in reader:
+            rows.append((reader.line_num, row))
+    except csv.Error as exc:
+        if "unexpected end of data" not in str(exc):
+            raise _not_ours(path, reader.line_num) from None
+        torn = True  # the file ends inside a quoted cell: the last record was cut short
+    else:
+        if rows and not text.endswith("\n"):
+            rows.pop()  # a record is whole once its newline is written
+            torn = True
+    if rows:
+        if rows[0][1] != columns:
+            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
+                               hint="use the same options, another -o, or --force to start it again")
+        rows = rows[1:]
+    entries = []
+    for n, row in rows:
+        if not row:
+            continue
+        e = _entry_csv(row, columns)
+        if e is None:
+            raise _not_ours(path, n)
+        entries.append(e)
+    return entries, torn
 
 
 def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
@@ -126,27 +172,22 @@ def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
     append to it (or to rewrite it) keeps someone's other file safe.
     """
     data = path.read_bytes()
-    torn = bool(data) and not data.endswith(b"\n")
     try:
-        lines = data.decode("utf-8").split("\n")
+        text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise WallcliError(f"{path} is not a wallcli scan results file (not UTF-8 text)",
                            hint="choose another -o, or --force to replace it") from None
-    lines = lines[:-1]  # the text after the last newline: '' or the torn line
-    if columns is not None and lines:
-        header = next(csv.reader([lines[0]]))
-        if header != columns:
-            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
-                               hint="use the same options, another -o, or --force to start it again")
-        lines = lines[1:]
+    if columns is not None:
+        return _read_csv(path, text, columns)
+    torn = bool(text) and not text.endswith("\n")
+    lines = text.split("\n")[:-1]  # the text after the last newline: '' or the torn line
     entries = []
-    for n, raw in enumerate(lines, start=2 if columns is not None else 1):
+    for n, raw in enumerate(lines, start=1):
         if not raw.strip():
             continue
-        e = _entry_csv(raw, columns) if columns is not None else _entry_json(raw)
+        e = _entry_json(raw)
         if e is None:
-            raise WallcliError(f"{path} line {n} is not a wallcli scan result",
-                               hint="choose another -o, or --force to replace the file")
+            raise _not_ours(path, n)
         entries.append(e)
     return entries, torn
 
@@ -161,17 +202,8 @@ class ResultsFile:
 
     def _format(self, line: dict) -> str:
         if self.columns is None:
-            return self.encode(line)
-        buf = io.StringIO()
-        csv.writer(buf, lineterminator="").writerow(flatten(line, self.columns))
-        return buf.getvalue()
-
-    def _header(self) -> list[str]:
-        if self.columns is None:
-            return []
-        buf = io.StringIO()
-        csv.writer(buf, lineterminator="").writerow(self.columns)
-        return [buf.getvalue()]
+            return self.encode(line) + "\n"
+        return csv_record(flatten(line, self.columns))
 
     def start(self, kept: list[Entry] | None) -> None:
         """Open for appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
@@ -179,15 +211,15 @@ class ResultsFile:
         if kept is not None:
             from wallcli.io.writer import atomic_path
 
+            header = [csv_record(self.columns)] if self.columns is not None else []
             with atomic_path(self.path, force=True) as tmp:
-                text = "".join(f"{raw}\n" for raw in self._header() + [e.raw for e in kept])
-                tmp.write_text(text, encoding="utf-8")
+                tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
         self._fh = open(self.path, "a", encoding="utf-8", newline="")
 
     def append(self, line: dict) -> None:
         # one write of the whole line, then flush and fsync: the line is on disk before the next
         # one starts, and a kill can tear at most the line being written
-        self._fh.write(self._format(line) + "\n")
+        self._fh.write(self._format(line))
         self._fh.flush()
         os.fsync(self._fh.fileno())
 
