@@ -282,3 +282,40 @@ def test_read_only_and_full_file_systems(tmp_path, clip, run_cli):
         assert sorted(p.name for p in full.iterdir()) == ["fill"]
 
 
+# 8 --------------------------------------------------------------------- one scan per results file
+def test_a_second_scan_of_one_results_file_stops_at_once(tmp_path, video, run_cli):
+    folder = _copies(tmp_path / "v", video, [f"v{i}.mp4" for i in range(4)])
+    out = tmp_path / "r.jsonl"
+    first = subprocess.Popen([*WALLCLI, "scan", str(folder), "-o", str(out), "--workers", "1"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while not out.exists() and first.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        code, _, err = run_cli("scan", folder, "-o", out, "--workers", "1")
+        assert first.poll() is None, "the first scan ended too soon for this test"
+        assert code == 1 and "another wallcli scan is writing" in _one_error(err)
+        assert first.wait(timeout=300) == 0, first.stderr.read()
+    finally:
+        if first.poll() is None:
+            first.kill()
+    assert sorted(Path(d["input"]).name for d in _lines(out)) == [f"v{i}.mp4" for i in range(4)]  # each once
+
+
+def test_report_counts_each_video_once(tmp_path, run_cli):
+    from wallcli.cli.output import to_json
+
+    lines = [to_json({"input": f"cam/{i}.mp4", "size": 10, "sha256": str(i) * 64, "duration": 10.0, "frames": 300,
+                      "tasks": ["snr"], "error": None}) for i in range(3)]
+    results = tmp_path / "r.jsonl"
+    results.write_text("\n".join(lines + lines[:2] + ['{"input": "cam/0.mp4", "tasks": ["snr"], "error": "x"}']) + "\n")
+    code, _, err = run_cli("report", results, "-o", tmp_path / "index.html")
+    assert code == 0, err
+    assert "2 videos appear on more than one line" in " ".join(err.split())
+    import re
+
+    page = (tmp_path / "index.html").read_text(encoding="utf-8")
+    total = {k: int(v) for k, v in re.findall(r'id="total-(\w+)"[^>]*>(\d+)<', page)}
+    assert total["videos"] == 3 and total["failed"] == 1  # cam/0's last line is its failure
+
+

@@ -1,6 +1,8 @@
 """The results file of ``wallcli scan``: JSON Lines (or CSV), appended line by line.
 
-The file is the run's only memory. Every finished video's line is written, flushed and fsynced
+The file is the run's only memory, and one run at a time writes it: a scan holds an advisory
+lock (``flock``) on it from before it reads it until it ends, and a second scan of the same file
+stops at once, saying so (two writers would both append every video). Every finished video's line is written, flushed and fsynced
 before the next one is, so a crash, Ctrl-C or ``kill -9`` leaves every finished line intact and
 at most one torn last line, which the next run drops. On that next run, lines of videos that are
 unchanged (same sha256) and scanned for the same tasks are kept and their videos skipped;
@@ -10,9 +12,11 @@ exactly one line.
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import json
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -194,11 +198,51 @@ def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
 
 # ------------------------------------------------------------------------------------- writing
 class ResultsFile:
-    """Append-only writer of one line per video; ``header`` (CSV) is written once, at creation."""
+    """The results file of one run: :meth:`open` (and lock) it before reading it, :meth:`start`
+    appending, :meth:`append` a line per video, :meth:`close` (or :meth:`abandon`) at the end."""
 
     def __init__(self, path: Path, encode: Callable[[dict], str], columns: list[str] | None = None):
         self.path, self.encode, self.columns = Path(path), encode, columns
+        self.created = False  # by this run: removed again if the run fails before its first line
+        self.appended = 0
+        self._fd: int | None = None
         self._fh = None
+
+    def open(self) -> None:
+        """Open the file, creating it if absent, and take its lock; a scan already holding it is
+        an error, at once (a batch that waited would only redo that scan's work)."""
+        flags = os.O_RDWR | os.O_APPEND | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+        for _ in range(20):
+            try:
+                try:
+                    fd = os.open(self.path, flags | os.O_CREAT | os.O_EXCL, 0o666)
+                    created = True
+                except FileExistsError:
+                    fd = os.open(self.path, flags)  # O_NONBLOCK: a FIFO put there meanwhile must not hang us
+                    created = False
+            except FileNotFoundError:
+                continue  # removed between the two opens: try again
+            except OSError as exc:
+                raise WallcliError(f"cannot open {self.path}: {_reason(exc)}") from None
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                os.close(fd)
+                raise WallcliError(f"{self.path} is not a regular file; scan results go to a file")
+            try:
+                _lock(fd, self.path)
+            except BaseException:
+                os.close(fd)
+                raise
+            try:
+                same = os.path.samestat(os.stat(self.path), os.fstat(fd))
+            except OSError:
+                same = False
+            if same:
+                self._fd, self.created = fd, created
+                return
+            # the scan that held the lock replaced or removed the file before letting go: the lock
+            # taken is on a file no longer there; the one at the path now is the one to lock
+            os.close(fd)
+        raise WallcliError(f"cannot lock {self.path}: it keeps being replaced (another scan?)")
 
     def _format(self, line: dict) -> str:
         if self.columns is None:
@@ -206,24 +250,79 @@ class ResultsFile:
         return csv_record(flatten(line, self.columns))
 
     def start(self, kept: list[Entry] | None) -> None:
-        """Open for appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
+        """Start appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
         atomically, by a fresh file holding the header and ``kept``'s lines."""
         if kept is not None:
             from wallcli.io.writer import atomic_path
 
             header = [csv_record(self.columns)] if self.columns is not None else []
-            with atomic_path(self.path, force=True) as tmp:
-                tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
-        self._fh = open(self.path, "a", encoding="utf-8", newline="")
+            new = None
+            try:
+                with atomic_path(self.path, force=True) as tmp:
+                    tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
+                    # locked before the rename, and the lock goes with the file: there is no moment
+                    # when the path names an unlocked file another scan could take
+                    new = os.open(tmp, os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0))
+                    _lock(new, self.path)
+            except BaseException:
+                if new is not None:
+                    os.close(new)
+                raise
+            os.close(self._fd)
+            self._fd = new
+        self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
 
     def append(self, line: dict) -> None:
         # one write of the whole line, then flush and fsync: the line is on disk before the next
         # one starts, and a kill can tear at most the line being written
-        self._fh.write(self._format(line))
-        self._fh.flush()
-        os.fsync(self._fh.fileno())
+        try:
+            self._fh.write(self._format(line))
+            self._fh.flush()
+            os.fsync(self._fh.fileno())
+        except OSError as exc:  # a full disk, a quota: the lines before this one are whole
+            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
+        self.appended += 1
 
     def close(self) -> None:
-        if self._fh is not None:
-            self._fh.close()
-            self._fh = None
+        fh, fd, self._fh, self._fd = self._fh, self._fd, None, None
+        try:
+            if fh is not None:
+                fh.close()
+            elif fd is not None:
+                os.close(fd)
+        except OSError as exc:
+            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
+
+    def abandon(self) -> None:
+        """Close after a failure; a file this run created and never wrote a line to is removed
+        (while still locked, so no other scan can have opened it meanwhile)."""
+        try:
+            if self.created and not self.appended:
+                self.path.unlink(missing_ok=True)
+            self.close()
+        except (OSError, WallcliError):  # a full disk refuses the unwritten rest again: the first error tells
+            pass
+
+
+def _reason(exc: OSError) -> str:
+    text = exc.strerror or str(exc)
+    return text[:1].lower() + text[1:]
+
+
+def _lock(fd: int, path: Path) -> None:
+    """An exclusive advisory lock on the open file ``fd``; an error naming ``path`` when another
+    process holds one. flock, not lockf: a POSIX lock is dropped when the process closes *any*
+    descriptor of the file, as reading it does."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock, as before
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise WallcliError(f"another wallcli scan is writing {path}",
+                           hint="wait for it to end, or choose another -o") from None
+    except OSError as exc:
+        if exc.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS):
+            return  # a file system without locks (some network ones): carry on unlocked, as before
+        raise WallcliError(f"cannot lock {path}: {_reason(exc)}") from None
