@@ -319,3 +319,17 @@ def test_report_counts_each_video_once(tmp_path, run_cli):
     assert total["videos"] == 3 and total["failed"] == 1  # cam/0's last line is its failure
 
 
+# 9 -------------------------------------------------------- the results file among the videos
+def test_rescanning_a_folder_that_holds_its_results_file_resumes(tmp_path, video, run_cli):
+    folder = _copies(tmp_path / "gl", video, ["v.mp4"])
+    out = folder / "res.jsonl"
+    code, _, err = run_cli("scan", folder, "-o", out, "--glob", "*", "--workers", "1", "--task", "snr")
+    assert code == 0, err
+    before = out.read_bytes()
+    code, stdout, err = run_cli("scan", folder, "-o", out, "--glob", "*", "--workers", "1", "--task", "snr", "--json")
+    assert code == 0, err
+    assert json.loads(stdout)["skipped"] == 1 and out.read_bytes() == before
+    code, _, err = run_cli("scan", out, "-o", out)  # named as an input: that is a mistake, said so
+    assert code == 1 and "is the input" in _one_error(err)
+
+

@@ -85,7 +85,8 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
     from wallcli.io.writer import check_output
 
     tasks = tuple(t for t in TASKS if t in tasks)
-    sources = expand_inputs([str(i) for i in inputs], globs)
+    # the results file inside a scanned folder is not a video: running the command again resumes
+    sources = expand_inputs([str(i) for i in inputs], globs, skip=Path(output))
     out = check_output(output, force=True, inputs=[s for s in sources if not is_url(s)])
     columns = csv_columns(tasks, _classes(tasks), windows) if is_csv(out) else None
     results = ResultsFile(out, encode, columns)
