@@ -228,6 +228,47 @@ def test_scan_csv_with_newlines_and_quotes_in_names_resumes(tmp_path, video, run
     assert json.loads(stdout)["skipped"] == 4 and out.read_bytes() == before
 
 
+# 5 --------------------------------------------------------------------------------------- Ctrl-C
+def _live(pgid: int) -> list[str]:
+    ps = subprocess.run(["ps", "-o", "stat=,args=", "-g", str(pgid)], capture_output=True, text=True).stdout
+    return [p for p in ps.splitlines() if p.strip() and not p.split()[0].startswith("Z")]  # zombies are not ours to reap
+
+
+@pytest.mark.skipif(not hasattr(os, "killpg") or shutil.which("ps") is None, reason="needs process groups and ps")
+@pytest.mark.parametrize("moment", ["start-up", "work"])
+def test_ctrl_c_during_a_scan_is_one_line(tmp_path, video, moment):
+    import psutil
+
+    folder = _copies(tmp_path / "v", video, [f"v{i}.mp4" for i in range(6)])
+    out = tmp_path / "r.jsonl"
+    # a session of its own: the signal goes to the whole group, as a terminal's Ctrl-C does
+    proc = subprocess.Popen([*WALLCLI, "scan", str(folder), "-o", str(out), "--workers", "2"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            if moment == "start-up":
+                with contextlib.suppress(psutil.Error):
+                    kids = [p for p in psutil.Process(proc.pid).children(recursive=True)
+                            if "spawn_main" in " ".join(p.cmdline())]
+                    if any(time.time() - p.create_time() > 0.5 for p in kids):  # a worker is importing
+                        break
+            elif out.exists() and out.read_text().count("\n") >= 1:
+                break
+            time.sleep(0.02)
+        assert proc.poll() is None, f"the scan ended before the signal: {proc.stderr.read()}"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+        assert proc.returncode == 1 and err == "Error: interrupted\n"
+        deadline = time.monotonic() + 30
+        while _live(proc.pid) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert _live(proc.pid) == []  # every worker went with it
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+
+
 # 7 ----------------------------------------------------- outputs the file system cannot take
 @pytest.mark.parametrize("name", ["n" * 245 + ".jsonl", "n" * 251 + ".npz", "é" * 124 + ".npz", "x." + "s" * 253])
 def test_temporaries_of_long_names_fit_the_file_system(tmp_path, name):
@@ -333,3 +374,22 @@ def test_rescanning_a_folder_that_holds_its_results_file_resumes(tmp_path, video
     assert code == 1 and "is the input" in _one_error(err)
 
 
+# 12 ------------------------------------------------------------------- workers that cannot start
+NO_INTERPRETER = ("import multiprocessing, sys\nmultiprocessing.set_executable(sys.argv.pop(1))\n"
+                  "from wallcli.cli.entry import main\nmain()\n")
+
+
+@pytest.mark.parametrize("script,mode,words", [("not a program\n", 0o644, "permission denied"),
+                                               ("#!/bin/sh\necho 'no licence here' >&2\nexit 3\n", 0o755,
+                                                "exits at once: no licence here")])
+def test_workers_that_cannot_start_are_one_clean_line(tmp_path, video, script, mode, words):
+    python = tmp_path / "python"  # the interpreter the worker processes would run
+    python.write_text(script)
+    python.chmod(mode)
+    out = tmp_path / "r.jsonl"
+    res = subprocess.run([sys.executable, "-c", NO_INTERPRETER, str(python), "scan", str(video), "-o", str(out),
+                          "--workers", "2"], capture_output=True, text=True, timeout=300)
+    line = _one_error(res.stderr)
+    assert res.returncode == 1 and "the local Dask cluster could not start" in line
+    assert str(python) in line and words in line
+    assert not out.exists()
