@@ -269,6 +269,78 @@ def test_ctrl_c_during_a_scan_is_one_line(tmp_path, video, moment):
             os.killpg(proc.pid, signal.SIGKILL)
 
 
+# 6 --------------------------------------------------------------------- not a Dask scheduler
+SHORT_TIMEOUT = ("import sys, wallcli.batch.engine as e; e.CONNECT_TIMEOUT = 2.0\n"
+                 "from wallcli.cli.entry import main\nmain()\n")
+
+
+@contextlib.contextmanager
+def _server(handler):
+    """A TCP server on 127.0.0.1 (a free port) calling ``handler(conn)`` per connection; stopped at the end."""
+    sock = socket.create_server(("127.0.0.1", 0))
+    stop = threading.Event()
+
+    def serve():
+        sock.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                conn, _ = sock.accept()
+            except (socket.timeout, OSError):
+                continue
+            threading.Thread(target=handler, args=(conn, stop), daemon=True).start()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        yield f"tcp://127.0.0.1:{sock.getsockname()[1]}"
+    finally:
+        stop.set()
+        thread.join(5)
+        sock.close()
+
+
+def _http(conn, stop):  # an HTTP server: waits for a request line that never ends
+    with conn:
+        conn.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                if not conn.recv(65536):
+                    return
+            except socket.timeout:
+                continue
+            except OSError:
+                return
+
+
+def _garbage(conn, stop):  # answers anything with bytes that are no Dask message
+    with conn:
+        with contextlib.suppress(OSError):
+            conn.sendall(b"\xff" * 64 + b"HTTP/1.0 400 Bad Request\r\n\r\n" * 8)
+            stop.wait(30)
+
+
+@pytest.mark.parametrize("handler,words", [(_http, "did not answer as a Dask scheduler within 2 s"),
+                                           (_garbage, "answered, but not as a Dask scheduler")])
+def test_a_scheduler_address_that_is_no_dask_scheduler(tmp_path, clip, handler, words):
+    out = tmp_path / "r.jsonl"
+    with _server(handler) as address:
+        t0 = time.monotonic()
+        res = subprocess.run([sys.executable, "-c", SHORT_TIMEOUT, "scan", str(clip), "-o", str(out),
+                              "--scheduler", address], capture_output=True, text=True, timeout=120,
+                             preexec_fn=_limited(3 << 30))
+    line = _one_error(res.stderr)
+    assert res.returncode == 1 and address in line and words in line and "memory" not in line
+    assert time.monotonic() - t0 < 60
+    assert not out.exists()  # no empty results file left behind
+
+
+def test_scan_help_states_the_scheduler_timeout(run_cli):
+    from wallcli.batch.engine import CONNECT_TIMEOUT
+
+    code, out, _ = run_cli("scan", "--help")
+    assert code == 0 and f"time out after {CONNECT_TIMEOUT:g} s" in " ".join(out.split())
+
+
 # 7 ----------------------------------------------------- outputs the file system cannot take
 @pytest.mark.parametrize("name", ["n" * 245 + ".jsonl", "n" * 251 + ".npz", "é" * 124 + ".npz", "x." + "s" * 253])
 def test_temporaries_of_long_names_fit_the_file_system(tmp_path, name):

@@ -19,6 +19,12 @@ from wallcli.errors import WallcliError
 # (KilledWorker): a video that kills its worker is tried once more, then becomes an error line.
 ALLOWED_FAILURES = 1
 
+# Seconds to reach a --scheduler and complete Dask's handshake with it (cli/scan.py says so in
+# --help). Dask's own connect() waits for the other side's handshake without a limit: an HTTP
+# server on the port kept a scan waiting for ever.
+CONNECT_TIMEOUT = 20.0
+
+
 def default_workers() -> int:
     try:
         return max(1, len(os.sched_getaffinity(0)))
@@ -99,6 +105,49 @@ def _why_not_started(exc: BaseException) -> str:
     return f"{_first_line(exc)} ({type(root).__name__}: {_first_line(root)})" if root is not exc else _first_line(exc)
 
 
+def _handshake(address: str, timeout: float) -> None:
+    """Connect to ``address`` and complete Dask's handshake within ``timeout`` seconds, or fail
+    with a line naming the address. Dask's Client waits for the handshake for ever and believes
+    whatever comes back (an HTTP server hung it; garbage made it allocate exabytes)."""
+    import asyncio
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import get_backend
+
+    from wallcli.errors import UsageError
+
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as exc:
+        raise UsageError(f"--scheduler {address} is not a Dask scheduler address ({_first_line(exc)})",
+                         hint="e.g. tcp://10.0.0.5:8786") from None
+
+    async def shake() -> Any:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        try:
+            return comm.remote_info
+        finally:
+            comm.abort()
+
+    try:
+        info = asyncio.run(shake())
+    except (asyncio.TimeoutError, TimeoutError):
+        raise WallcliError(f"{address} did not answer as a Dask scheduler within {timeout:g} s "
+                           "(is it one? is the port right?)") from None
+    except OSError as exc:
+        raise WallcliError(f"cannot reach the Dask scheduler at {address}: {_first_line(exc)}") from None
+    except (KeyboardInterrupt, WallcliError):
+        raise
+    except (Exception, MemoryError):  # noqa: BLE001 - garbage read as a message: any decoder error
+        raise WallcliError(f"{address} answered, but not as a Dask scheduler") from None
+    if not isinstance(info, dict) or "pickle-protocol" not in info:
+        raise WallcliError(f"{address} answered, but not as a Dask scheduler")
+
+
 class Engine:
     """``with Engine(...) as e: for item, line in e.map(fn, items, config): ...``"""
 
@@ -117,7 +166,6 @@ class Engine:
         # distributed's defaults must be in the config before dask.config.set() below saves it:
         # otherwise leaving set() removes every distributed.* key, under a cluster still closing
         import distributed  # noqa: F401
-        from distributed import Client
 
         logging.getLogger("distributed").setLevel(self.level)
         # one task per worker thread at a time: a worker that dies then takes down one video, not
@@ -129,11 +177,7 @@ class Engine:
             if self.scheduler is None:
                 self._start_local()
             else:
-                try:
-                    self.client = Client(self.scheduler, timeout="20s")
-                except (OSError, TimeoutError, ValueError) as exc:
-                    raise WallcliError(f"cannot reach the Dask scheduler at {self.scheduler}: "
-                                       f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+                self._connect()
                 self._check_workers()
             if self.scheduler is not None or _has_dashboard():
                 # a remote scheduler's dashboard is its own business: announce what it serves
@@ -172,6 +216,18 @@ class Engine:
             raise
         except Exception as exc:  # noqa: BLE001 - Dask's own failure to start is the user's one line
             raise WallcliError(f"the local Dask cluster could not start: {_why_not_started(exc)}") from None
+
+    def _connect(self) -> None:
+        from distributed import Client
+
+        address = self.scheduler
+        _handshake(address, CONNECT_TIMEOUT)
+        try:
+            self.client = Client(address, timeout=f"{CONNECT_TIMEOUT}s")
+        except (KeyboardInterrupt, WallcliError):
+            raise
+        except Exception as exc:  # noqa: BLE001 - whatever went wrong, it is this address's fault
+            raise WallcliError(f"cannot use the Dask scheduler at {address}: {_first_line(exc)}") from None
 
     def __exit__(self, *exc) -> None:
         self.close()
