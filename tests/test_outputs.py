@@ -9,7 +9,7 @@ import pytest
 from clips import write_clip
 
 import wallcli.io.video as video
-from wallcli.errors import UsageError
+from wallcli.errors import UsageError, WallcliError
 from wallcli.io.writer import atomic_paths, check_outputs
 
 SIM = ["--size", "32x32", "--duration", "0.4", "--fps", "15", "--grid", "4x4"]
@@ -82,7 +82,8 @@ def test_atomic_paths_removes_the_first_when_the_second_rename_fails(tmp_path, m
         real(src, dst)
 
     monkeypatch.setattr(os, "replace", flaky)
-    with pytest.raises(OSError, match="rename failed"):
+    # a failed rename is the output's failure, named (one error line), not an internal error
+    with pytest.raises(WallcliError, match=r"cannot write .*t\.mkv: rename failed"):
         with atomic_paths([tmp_path / "t.json", tmp_path / "t.mkv"]) as (a, b):
             a.write_text("{}")
             b.write_bytes(b"video")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import os
 import uuid
+from contextlib import contextmanager
 from typing import Any, Callable, Iterator
 
 from wallcli.errors import WallcliError
@@ -17,6 +18,11 @@ from wallcli.errors import WallcliError
 # Dask's scheduler retries a task whose worker died this many times before giving up on it
 # (KilledWorker): a video that kills its worker is tried once more, then becomes an error line.
 ALLOWED_FAILURES = 1
+
+# Seconds to reach a --scheduler and complete Dask's handshake with it (cli/scan.py says so in
+# --help). Dask's own connect() waits for the other side's handshake without a limit: an HTTP
+# server on the port kept a scan waiting for ever.
+CONNECT_TIMEOUT = 20.0
 
 
 def default_workers() -> int:
@@ -34,6 +40,114 @@ def _has_dashboard() -> bool:
     return importlib.util.find_spec("bokeh") is not None
 
 
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+@contextmanager
+def _terminal_signals_held() -> Iterator[Callable[[], None]]:
+    """Start the local cluster with Ctrl-C, a closed terminal and `kill` held back; yields a
+    function that holds them again (for code that unblocks them: multiprocessing does).
+
+    A terminal sends Ctrl-C (and SIGHUP) to every process of its foreground group, Dask's worker
+    processes included: each printed a KeyboardInterrupt traceback, and one landing in the
+    cluster's start-up left it half made (``AssertionError: Status.init``). Threads and
+    processes inherit a blocked signal: Dask's threads and every process started here (or later,
+    by those threads, to replace a dead worker) never receive these, and the workers are stopped
+    by this process instead, in order. This thread's own signals wait until the cluster is up,
+    then land as usual.
+    """
+    import signal
+
+    held = {getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)}
+    if not hasattr(signal, "pthread_sigmask") or not held:
+        yield lambda: None
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield lambda: signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
+def _worker_interpreter_problem() -> str | None:
+    """Why this interpreter cannot start a worker process, or None.
+
+    Dask's worker processes run it. One this user may not run (or that exits at once) fails deep
+    in Dask ('Nanny failed to start'), after multiprocessing made locks whose clean-up then
+    prints BrokenPipeError tracebacks at exit, and after the failing processes wrote to our
+    stderr. Started here first (a few hundredths of a second), it is one line saying why.
+    """
+    import subprocess
+    from multiprocessing import spawn
+
+    exe = os.fsdecode(spawn.get_executable())
+    try:
+        run = subprocess.run([exe, "-c", "import multiprocessing.spawn"], stdin=subprocess.DEVNULL,
+                             capture_output=True, timeout=120)
+    except OSError as err:
+        reason = err.strerror or str(err)
+        return f"its worker processes cannot run {exe} ({reason[:1].lower() + reason[1:]})"
+    except subprocess.TimeoutExpired:
+        return f"a worker process ({exe}) did not start within 120 s"
+    if run.returncode != 0:
+        tail = run.stderr.decode("utf-8", "replace").strip().splitlines()
+        return f"a worker process ({exe}) exits at once: {tail[-1] if tail else f'status {run.returncode}'}"
+    return None
+
+
+def _why_not_started(exc: BaseException) -> str:
+    """Dask's own words ('Nanny failed to start.') and the first failure under them."""
+    root = exc
+    while root.__cause__ is not None or root.__context__ is not None:
+        root = root.__cause__ or root.__context__
+    return f"{_first_line(exc)} ({type(root).__name__}: {_first_line(root)})" if root is not exc else _first_line(exc)
+
+
+def _handshake(address: str, timeout: float) -> None:
+    """Connect to ``address`` and complete Dask's handshake within ``timeout`` seconds, or fail
+    with a line naming the address. Dask's Client waits for the handshake for ever and believes
+    whatever comes back (an HTTP server hung it; garbage made it allocate exabytes)."""
+    import asyncio
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import get_backend
+
+    from wallcli.errors import UsageError
+
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as exc:
+        raise UsageError(f"--scheduler {address} is not a Dask scheduler address ({_first_line(exc)})",
+                         hint="e.g. tcp://10.0.0.5:8786") from None
+
+    async def shake() -> Any:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        try:
+            return comm.remote_info
+        finally:
+            comm.abort()
+
+    try:
+        info = asyncio.run(shake())
+    except (asyncio.TimeoutError, TimeoutError):
+        raise WallcliError(f"{address} did not answer as a Dask scheduler within {timeout:g} s "
+                           "(is it one? is the port right?)") from None
+    except OSError as exc:
+        raise WallcliError(f"cannot reach the Dask scheduler at {address}: {_first_line(exc)}") from None
+    except (KeyboardInterrupt, WallcliError):
+        raise
+    except (Exception, MemoryError):  # noqa: BLE001 - garbage read as a message: any decoder error
+        raise WallcliError(f"{address} answered, but not as a Dask scheduler") from None
+    if not isinstance(info, dict) or "pickle-protocol" not in info:
+        raise WallcliError(f"{address} answered, but not as a Dask scheduler")
+
+
 class Engine:
     """``with Engine(...) as e: for item, line in e.map(fn, items, config): ...``"""
 
@@ -49,7 +163,9 @@ class Engine:
     # -- start / stop -------------------------------------------------------------------------
     def __enter__(self) -> "Engine":
         import dask
-        from distributed import Client, LocalCluster
+        # distributed's defaults must be in the config before dask.config.set() below saves it:
+        # otherwise leaving set() removes every distributed.* key, under a cluster still closing
+        import distributed  # noqa: F401
 
         logging.getLogger("distributed").setLevel(self.level)
         # one task per worker thread at a time: a worker that dies then takes down one video, not
@@ -59,20 +175,9 @@ class Engine:
         self._config.__enter__()
         try:
             if self.scheduler is None:
-                # loopback only: a cluster on this machine has no business listening on the network
-                # (Dask moves to a free port when 8787 is taken; without bokeh there is no dashboard
-                # and its placeholder page goes on any free port)
-                self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                            host="127.0.0.1",
-                                            dashboard_address="127.0.0.1:8787" if _has_dashboard() else "127.0.0.1:0",
-                                            silence_logs=self.level)
-                self.client = Client(self.cluster)
+                self._start_local()
             else:
-                try:
-                    self.client = Client(self.scheduler, timeout="20s")
-                except (OSError, TimeoutError, ValueError) as exc:
-                    raise WallcliError(f"cannot reach the Dask scheduler at {self.scheduler}: "
-                                       f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+                self._connect()
                 self._check_workers()
             if self.scheduler is not None or _has_dashboard():
                 # a remote scheduler's dashboard is its own business: announce what it serves
@@ -82,6 +187,47 @@ class Engine:
             self.close()
             raise
         return self
+
+    def _start_local(self) -> None:
+        from multiprocessing import resource_tracker
+
+        from distributed import Client, LocalCluster
+
+        problem = _worker_interpreter_problem()
+        if problem:
+            raise WallcliError(f"the local Dask cluster could not start: {problem}")
+        try:
+            with _terminal_signals_held() as hold_again:
+                # multiprocessing's resource tracker (a process) starts with the blocked signals
+                # it inherits, then unblocks SIGINT and SIGTERM in the thread that started it:
+                # started here, first, it keeps SIGHUP held too, and Dask's thread that would
+                # otherwise start it keeps its block for the workers
+                resource_tracker.ensure_running()
+                hold_again()
+                # loopback only: a cluster on this machine has no business listening on the network
+                # (Dask moves to a free port when 8787 is taken; without bokeh there is no dashboard
+                # and its placeholder page goes on any free port)
+                self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
+                                            host="127.0.0.1",
+                                            dashboard_address="127.0.0.1:8787" if _has_dashboard() else "127.0.0.1:0",
+                                            silence_logs=self.level)
+                self.client = Client(self.cluster)
+        except (KeyboardInterrupt, WallcliError, MemoryError):
+            raise
+        except Exception as exc:  # noqa: BLE001 - Dask's own failure to start is the user's one line
+            raise WallcliError(f"the local Dask cluster could not start: {_why_not_started(exc)}") from None
+
+    def _connect(self) -> None:
+        from distributed import Client
+
+        address = self.scheduler
+        _handshake(address, CONNECT_TIMEOUT)
+        try:
+            self.client = Client(address, timeout=f"{CONNECT_TIMEOUT}s")
+        except (KeyboardInterrupt, WallcliError):
+            raise
+        except Exception as exc:  # noqa: BLE001 - whatever went wrong, it is this address's fault
+            raise WallcliError(f"cannot use the Dask scheduler at {address}: {_first_line(exc)}") from None
 
     def __exit__(self, *exc) -> None:
         self.close()

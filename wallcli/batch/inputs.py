@@ -21,12 +21,22 @@ def _matches(name: str, globs: list[str] | None) -> bool:
     return any(fnmatch.fnmatchcase(name, g) for g in globs)
 
 
-def _walk(folder: str, globs: list[str] | None) -> list[str]:
+def _identity(path) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return st.st_dev, st.st_ino
+
+
+def _walk(folder: str, globs: list[str] | None, skip: tuple[int, int] | None = None) -> list[str]:
     found = []
     for root, dirs, files in os.walk(folder):
         # hidden entries: editors' and wallcli's own temporaries (.NAME.XXXX.tmp.mp4), .git
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         found += [os.path.join(root, f) for f in sorted(files) if not f.startswith(".") and _matches(f, globs)]
+    if skip is not None:
+        found = [f for f in found if _identity(f) != skip]
     return found
 
 
@@ -44,14 +54,16 @@ def _read_list(arg: str) -> list[str]:
     return [s for s in (line.strip() for line in text.splitlines()) if s and not s.startswith("#")]
 
 
-def expand_inputs(args: list[str], globs: list[str] | None = None) -> list[str]:
+def expand_inputs(args: list[str], globs: list[str] | None = None, skip: str | os.PathLike | None = None) -> list[str]:
     """The videos named by ``args``, in order, each once.
 
     A folder gives the files under it whose names match ``globs`` (default: the usual video
     extensions, any case); a file or URL is taken as is; ``@list.txt`` gives its lines. A path on
     the command line that does not exist is an error (a typo should not cost a run), and so is
-    finding no video at all.
+    finding no video at all. A file found in a folder that is ``skip`` (the results file, which
+    may lie among the videos) is left out.
     """
+    skipped = _identity(skip) if skip is not None else None
     out: list[str] = []
     seen: set[str] = set()
     empty_folders = []
@@ -72,7 +84,7 @@ def expand_inputs(args: list[str], globs: list[str] | None = None) -> list[str]:
         elif is_url(arg):
             add(arg)
         elif os.path.isdir(arg):
-            found = _walk(arg, globs)
+            found = _walk(arg, globs, skipped)
             if not found:
                 empty_folders.append(arg)
             for f in found:

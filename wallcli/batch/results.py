@@ -1,6 +1,8 @@
 """The results file of ``wallcli scan``: JSON Lines (or CSV), appended line by line.
 
-The file is the run's only memory. Every finished video's line is written, flushed and fsynced
+The file is the run's only memory, and one run at a time writes it: a scan holds an advisory
+lock (``flock``) on it from before it reads it until it ends, and a second scan of the same file
+stops at once, saying so (two writers would both append every video). Every finished video's line is written, flushed and fsynced
 before the next one is, so a crash, Ctrl-C or ``kill -9`` leaves every finished line intact and
 at most one torn last line, which the next run drops. On that next run, lines of videos that are
 unchanged (same sha256) and scanned for the same tasks are kept and their videos skipped;
@@ -10,14 +12,17 @@ exactly one line.
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import json
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
 from wallcli.errors import WallcliError
+from wallcli.io.text import escape_surrogates, unescape_surrogates
 
 BASE = ["input", "size", "sha256", "duration", "frames", "tasks", "seconds", "error", "warnings"]
 CHANNELS = ("r", "g", "b")
@@ -58,6 +63,18 @@ def _cell(value: Any) -> str:
     if isinstance(value, (int, float, str)):
         return str(value)
     return json.dumps(value, ensure_ascii=False)  # lists of objects (windows, scales), warnings
+
+
+def csv_record(cells: list[str]) -> str:
+    """One CSV record, newline included, that ``csv.reader`` reads back as ``cells`` whatever they
+    hold: newlines and quotes inside a cell are quoted (a file name may hold them), and a file
+    name's undecodable bytes are escaped as in JSON (a CSV is UTF-8 text)."""
+    buf = io.StringIO()
+    # csv.writer quotes a cell holding the line terminator's characters, but not a bare '\r',
+    # which readers take for a line end: a row holding one is quoted whole
+    quoting = csv.QUOTE_ALL if any("\r" in c for c in cells) else csv.QUOTE_MINIMAL
+    csv.writer(buf, lineterminator="\n", quoting=quoting).writerow(cells)
+    return escape_surrogates(buf.getvalue())
 
 
 def flatten(line: dict, columns: list[str]) -> list[str]:
@@ -104,11 +121,7 @@ def _entry_json(raw: str) -> Entry | None:
     return Entry(raw, d["input"], d.get("size"), d.get("sha256"), tuple(d["tasks"]), d.get("error"))
 
 
-def _entry_csv(raw: str, header: list[str]) -> Entry | None:
-    try:
-        row = next(csv.reader(io.StringIO(raw)))
-    except (csv.Error, StopIteration):
-        return None
+def _entry_csv(row: list[str], header: list[str]) -> Entry | None:
     if len(row) != len(header):
         return None
     d = dict(zip(header, row))
@@ -116,8 +129,45 @@ def _entry_csv(raw: str, header: list[str]) -> Entry | None:
         size = int(d["size"]) if d["size"] else None
     except ValueError:
         return None
-    return Entry(raw, d["input"], size, d["sha256"] or None, tuple(t for t in d["tasks"].split(",") if t),
-                 d["error"] or None)
+    return Entry(csv_record(row)[:-1], unescape_surrogates(d["input"]), size, d["sha256"] or None,
+                 tuple(t for t in d["tasks"].split(",") if t), d["error"] or None)
+
+
+def _not_ours(path: Path, n: int) -> WallcliError:
+    return WallcliError(f"{path} line {n} is not a wallcli scan result",
+                        hint="choose another -o, or --force to replace the file")
+
+
+def _read_csv(path: Path, text: str, columns: list[str]) -> tuple[list[Entry], bool]:
+    """Records by the csv module's rules (a quoted cell may hold newlines), as they were written."""
+    reader = csv.reader(io.StringIO(text, newline=""), strict=True)
+    rows: list[tuple[int, list[str]]] = []
+    torn = False
+    try:
+        for row in reader:
+            rows.append((reader.line_num, row))
+    except csv.Error as exc:
+        if "unexpected end of data" not in str(exc):
+            raise _not_ours(path, reader.line_num) from None
+        torn = True  # the file ends inside a quoted cell: the last record was cut short
+    else:
+        if rows and not text.endswith("\n"):
+            rows.pop()  # a record is whole once its newline is written
+            torn = True
+    if rows:
+        if rows[0][1] != columns:
+            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
+                               hint="use the same options, another -o, or --force to start it again")
+        rows = rows[1:]
+    entries = []
+    for n, row in rows:
+        if not row:
+            continue
+        e = _entry_csv(row, columns)
+        if e is None:
+            raise _not_ours(path, n)
+        entries.append(e)
+    return entries, torn
 
 
 def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
@@ -127,72 +177,153 @@ def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
     append to it (or to rewrite it) keeps someone's other file safe.
     """
     data = path.read_bytes()
-    torn = bool(data) and not data.endswith(b"\n")
     try:
-        lines = data.decode("utf-8").split("\n")
+        text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise WallcliError(f"{path} is not a wallcli scan results file (not UTF-8 text)",
                            hint="choose another -o, or --force to replace it") from None
-    lines = lines[:-1]  # the text after the last newline: '' or the torn line
-    if columns is not None and lines:
-        header = next(csv.reader([lines[0]]))
-        if header != columns:
-            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
-                               hint="use the same options, another -o, or --force to start it again")
-        lines = lines[1:]
+    if columns is not None:
+        return _read_csv(path, text, columns)
+    torn = bool(text) and not text.endswith("\n")
+    lines = text.split("\n")[:-1]  # the text after the last newline: '' or the torn line
     entries = []
-    for n, raw in enumerate(lines, start=2 if columns is not None else 1):
+    for n, raw in enumerate(lines, start=1):
         if not raw.strip():
             continue
-        e = _entry_csv(raw, columns) if columns is not None else _entry_json(raw)
+        e = _entry_json(raw)
         if e is None:
-            raise WallcliError(f"{path} line {n} is not a wallcli scan result",
-                               hint="choose another -o, or --force to replace the file")
+            raise _not_ours(path, n)
         entries.append(e)
     return entries, torn
 
 
 # ------------------------------------------------------------------------------------- writing
 class ResultsFile:
-    """Append-only writer of one line per video; ``header`` (CSV) is written once, at creation."""
+    """The results file of one run: :meth:`open` (and lock) it before reading it, :meth:`start`
+    appending, :meth:`append` a line per video, :meth:`close` (or :meth:`abandon`) at the end."""
 
     def __init__(self, path: Path, encode: Callable[[dict], str], columns: list[str] | None = None):
         self.path, self.encode, self.columns = Path(path), encode, columns
+        self.created = False  # by this run: removed again if the run fails before its first line
+        self.appended = 0
+        self._fd: int | None = None
         self._fh = None
+
+    def open(self) -> None:
+        """Open the file, creating it if absent, and take its lock; a scan already holding it is
+        an error, at once (a batch that waited would only redo that scan's work)."""
+        flags = os.O_RDWR | os.O_APPEND | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+        for _ in range(20):
+            try:
+                try:
+                    fd = os.open(self.path, flags | os.O_CREAT | os.O_EXCL, 0o666)
+                    created = True
+                except FileExistsError:
+                    fd = os.open(self.path, flags)  # O_NONBLOCK: a FIFO put there meanwhile must not hang us
+                    created = False
+            except FileNotFoundError:
+                continue  # removed between the two opens: try again
+            except OSError as exc:
+                raise WallcliError(f"cannot open {self.path}: {_reason(exc)}") from None
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                os.close(fd)
+                raise WallcliError(f"{self.path} is not a regular file; scan results go to a file")
+            try:
+                _lock(fd, self.path)
+            except BaseException:
+                os.close(fd)
+                raise
+            try:
+                same = os.path.samestat(os.stat(self.path), os.fstat(fd))
+            except OSError:
+                same = False
+            if same:
+                self._fd, self.created = fd, created
+                return
+            # the scan that held the lock replaced or removed the file before letting go: the lock
+            # taken is on a file no longer there; the one at the path now is the one to lock
+            os.close(fd)
+        raise WallcliError(f"cannot lock {self.path}: it keeps being replaced (another scan?)")
 
     def _format(self, line: dict) -> str:
         if self.columns is None:
-            return self.encode(line)
-        buf = io.StringIO()
-        csv.writer(buf, lineterminator="").writerow(flatten(line, self.columns))
-        return buf.getvalue()
-
-    def _header(self) -> list[str]:
-        if self.columns is None:
-            return []
-        buf = io.StringIO()
-        csv.writer(buf, lineterminator="").writerow(self.columns)
-        return [buf.getvalue()]
+            return self.encode(line) + "\n"
+        return csv_record(flatten(line, self.columns))
 
     def start(self, kept: list[Entry] | None) -> None:
-        """Open for appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
+        """Start appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
         atomically, by a fresh file holding the header and ``kept``'s lines."""
         if kept is not None:
             from wallcli.io.writer import atomic_path
 
-            with atomic_path(self.path, force=True) as tmp:
-                text = "".join(f"{raw}\n" for raw in self._header() + [e.raw for e in kept])
-                tmp.write_text(text, encoding="utf-8")
-        self._fh = open(self.path, "a", encoding="utf-8", newline="")
+            header = [csv_record(self.columns)] if self.columns is not None else []
+            new = None
+            try:
+                with atomic_path(self.path, force=True) as tmp:
+                    tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
+                    # locked before the rename, and the lock goes with the file: there is no moment
+                    # when the path names an unlocked file another scan could take
+                    new = os.open(tmp, os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0))
+                    _lock(new, self.path)
+            except BaseException:
+                if new is not None:
+                    os.close(new)
+                raise
+            os.close(self._fd)
+            self._fd = new
+        self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
 
     def append(self, line: dict) -> None:
         # one write of the whole line, then flush and fsync: the line is on disk before the next
         # one starts, and a kill can tear at most the line being written
-        self._fh.write(self._format(line) + "\n")
-        self._fh.flush()
-        os.fsync(self._fh.fileno())
+        try:
+            self._fh.write(self._format(line))
+            self._fh.flush()
+            os.fsync(self._fh.fileno())
+        except OSError as exc:  # a full disk, a quota: the lines before this one are whole
+            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
+        self.appended += 1
 
     def close(self) -> None:
-        if self._fh is not None:
-            self._fh.close()
-            self._fh = None
+        fh, fd, self._fh, self._fd = self._fh, self._fd, None, None
+        try:
+            if fh is not None:
+                fh.close()
+            elif fd is not None:
+                os.close(fd)
+        except OSError as exc:
+            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
+
+    def abandon(self) -> None:
+        """Close after a failure; a file this run created and never wrote a line to is removed
+        (while still locked, so no other scan can have opened it meanwhile)."""
+        try:
+            if self.created and not self.appended:
+                self.path.unlink(missing_ok=True)
+            self.close()
+        except (OSError, WallcliError):  # a full disk refuses the unwritten rest again: the first error tells
+            pass
+
+
+def _reason(exc: OSError) -> str:
+    text = exc.strerror or str(exc)
+    return text[:1].lower() + text[1:]
+
+
+def _lock(fd: int, path: Path) -> None:
+    """An exclusive advisory lock on the open file ``fd``; an error naming ``path`` when another
+    process holds one. flock, not lockf: a POSIX lock is dropped when the process closes *any*
+    descriptor of the file, as reading it does."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock, as before
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise WallcliError(f"another wallcli scan is writing {path}",
+                           hint="wait for it to end, or choose another -o") from None
+    except OSError as exc:
+        if exc.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS):
+            return  # a file system without locks (some network ones): carry on unlocked, as before
+        raise WallcliError(f"cannot lock {path}: {_reason(exc)}") from None

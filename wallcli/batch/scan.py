@@ -45,7 +45,7 @@ def plan(sources: list[str], out: Path, tasks, *, force: bool, columns) -> tuple
     """(videos to do, videos skipped, the earlier lines to keep or None to keep the file as it is)."""
     from wallcli.batch.results import key, read
 
-    if force or not out.exists():
+    if force:
         return list(sources), 0, []
     entries, torn = read(out, columns)
     header_missing = columns is not None and out.stat().st_size == 0
@@ -85,22 +85,24 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
     from wallcli.io.writer import check_output
 
     tasks = tuple(t for t in TASKS if t in tasks)
-    sources = expand_inputs([str(i) for i in inputs], globs)
+    # the results file inside a scanned folder is not a video: running the command again resumes
+    sources = expand_inputs([str(i) for i in inputs], globs, skip=Path(output))
     out = check_output(output, force=True, inputs=[s for s in sources if not is_url(s)])
     columns = csv_columns(tasks, _classes(tasks), windows) if is_csv(out) else None
-    todo, skipped, kept = plan(sources, out, tasks, force=force, columns=columns)
-    if skipped:
-        log(f"{skipped} of {len(sources)} videos already in {out} (same sha256 and tasks): skipped; --force redoes them")
-    on_start(len(todo), skipped)
-    config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity())
-    existed = out.exists()
     results = ResultsFile(out, encode, columns)
-    results.start(kept)
+    results.open()  # and locked: from here to the end, no other scan writes it
     ok = failed = 0
     seconds_of_video = 0.0
-    t0 = time.perf_counter()
     engine_workers = 0
     try:
+        todo, skipped, kept = plan(sources, out, tasks, force=force, columns=columns)
+        if skipped:
+            log(f"{skipped} of {len(sources)} videos already in {out} (same sha256 and tasks): skipped; "
+                "--force redoes them")
+        on_start(len(todo), skipped)
+        config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity())
+        results.start(kept)
+        t0 = time.perf_counter()
         if todo:
             def failed_line(source: str, message: str) -> dict:
                 return {"input": source, "size": None, "sha256": None, "duration": None, "frames": None,
@@ -121,9 +123,7 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
                         failed += 1
                     on_line(line)
     except BaseException:
-        results.close()
-        if not existed and ok + failed == 0:  # a run that failed before its first line leaves no file
-            out.unlink(missing_ok=True)
+        results.abandon()  # a run that failed before its first line leaves no file it created
         raise
     results.close()
     wall = time.perf_counter() - t0

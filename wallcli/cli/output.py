@@ -38,8 +38,9 @@ def to_json(obj: Any) -> str:
     """Valid JSON whatever the strings hold: lone surrogates (the undecodable bytes of a file name
     that is not UTF-8) are written as \\udcXX escapes, which json.loads turns back into the same
     str (os.fsencode of it gives the original bytes); raw, they would put invalid UTF-8 on stdout."""
-    text = json.dumps(_clean(obj), ensure_ascii=False, allow_nan=False)
-    return _SURROGATE.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
+    from wallcli.io.text import escape_surrogates
+
+    return escape_surrogates(json.dumps(_clean(obj), ensure_ascii=False, allow_nan=False))
 
 
 def printable(text: Any) -> str:

@@ -15,14 +15,16 @@ def scan(
                                        "URLs, or @list.txt (one path or URL a line, # comments).", show_default=False,
                                        metavar="INPUT"),
     output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see docs/contract.md), "
-                                "or flattened CSV when the name ends in .csv. An existing file is resumed.",
+                                "or flattened CSV when the name ends in .csv. An existing file is resumed; one scan "
+                                "at a time writes it (a second one exits 1).",
                                 show_default=False),
     task: str = typer.Option("count,activity,snr", "--task", help="Comma list of count, activity, snr: what each video is "
                              "asked. All come from one decode of the video."),
     workers: Optional[int] = number_option(None, "--workers", lo=1, hi=MAX_THREADS, integer=True, help="Worker "
                                            "processes on this machine (one core each). Default: the number of cores."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run on an existing Dask cluster instead, e.g. "
-                                            "tcp://10.0.0.5:8786 (its workers need this wallcli version installed)."),
+                                            "tcp://10.0.0.5:8786 (its workers need this wallcli version installed). "
+                                            "Reaching it and Dask's handshake time out after 20 s (exit 1)."),
     glob: Optional[List[str]] = typer.Option(None, "--glob", help="File names to take from folders, e.g. '*.mp4' "
                                              "(repeatable). Default: the usual video extensions, any case."),
     force: bool = typer.Option(False, "--force", help="Start the results file again (every video redone) instead of "

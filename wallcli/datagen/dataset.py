@@ -97,10 +97,9 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
     """
     from wallcli.errors import WallcliError
     from wallcli.io.arrays import save_npz
-    from wallcli.io.writer import write_text_atomic
+    from wallcli.io.writer import output_folder, write_text_atomic
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
     rec = recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement, spp)
     if camera_overrides:
         rec["camera_overrides"] = dict(camera_overrides)

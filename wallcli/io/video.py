@@ -214,6 +214,8 @@ class VideoReader:
         else:
             p = Path(source)
             if not p.exists():
+                if p.is_symlink():  # exists() is False for a loop as for a dangling link: say which
+                    raise WallcliError(f"{source} is a symbolic link to nothing (a loop, or its target is gone)")
                 raise WallcliError(f"no such file: {source}")
             if p.is_dir():
                 raise WallcliError(f"{source} is a folder, not a video")

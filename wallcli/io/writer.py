@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import errno
 import os
+import stat
 import tempfile
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -12,11 +14,27 @@ from typing import Iterable, Iterator
 
 from wallcli.errors import WallcliError, raise_if_interrupted
 
+# errors of a write that say where it went, not what was read: the output's failure whatever the
+# code that met them (a muxer, savefig), so one clean line, not an internal error
+_OUTPUT_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}
+
+
+def _reason(exc: OSError) -> str:
+    text = exc.strerror or (os.strerror(exc.errno) if exc.errno else str(exc))
+    return (text[:1].lower() + text[1:]) if text else type(exc).__name__
+
 
 def _same_file(a: Path, b: Path) -> bool:
+    # os.path.realpath, not Path.resolve(): resolve() raises RuntimeError on a symlink loop, and one
+    # loop among the inputs would end the whole command
     try:
-        return a.resolve() == b.resolve() or (a.exists() and b.exists() and os.path.samefile(a, b))
-    except OSError:
+        if os.path.samefile(a, b):
+            return True
+    except (OSError, ValueError):
+        pass
+    try:
+        return os.path.realpath(a) == os.path.realpath(b)
+    except (OSError, ValueError):
         return False
 
 
@@ -24,6 +42,80 @@ def _umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
+
+
+def name_max(folder: str | os.PathLike) -> int:
+    """The longest file name (bytes) the file system of ``folder`` takes."""
+    try:
+        return int(os.pathconf(folder, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError):
+        return 255
+
+
+def _kind(mode: int) -> str:
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISFIFO(mode):
+        return "a named pipe (FIFO)"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "not a regular file"
+
+
+def _check_target(out: Path, *, force: bool) -> None:
+    """What is at ``out`` now: nothing (or a dangling link, which the rename replaces), or a regular
+    file that --force may replace. Anything else is refused before it is opened: a device or FIFO
+    would be read as an earlier result (/dev/zero without end, a FIFO forever) or replaced by the
+    rename (a root's /dev/null)."""
+    parent = out.parent if str(out.parent) else Path(".")
+    limit = name_max(parent)
+    if len(os.fsencode(out.name)) > limit:
+        raise WallcliError(f"output name is {len(os.fsencode(out.name))} bytes long; the file system of "
+                           f"{parent} takes at most {limit}")
+    try:
+        st = os.stat(out)
+    except FileNotFoundError:
+        st = None
+    except OSError as exc:
+        if exc.errno == errno.ENOTDIR or not parent.is_dir():
+            raise WallcliError(f"output folder does not exist: {parent}") from None
+        if exc.errno == errno.ELOOP:
+            raise WallcliError(f"output {out} is a symbolic link loop") from None
+        raise WallcliError(f"cannot use output {out}: {_reason(exc)}") from None
+    if not parent.is_dir():
+        raise WallcliError(f"output folder does not exist: {parent}")
+    if st is not None and stat.S_ISDIR(st.st_mode):
+        raise WallcliError(f"output is a folder: {out}")
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        raise WallcliError(f"output {out} is {_kind(st.st_mode)}; wallcli writes its outputs to files",
+                           hint="give a file path")
+    if st is not None and not force:
+        raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
+
+
+def _temporary(out: Path) -> Path:
+    """Create the empty temporary beside ``out`` that will become it: hidden (scan and editors skip
+    it), named after it so a leftover is recognisable, the same suffix (muxers choose the format by
+    it), and never longer than the file system's name limit, however long the output's name."""
+    parent = out.parent if str(out.parent) else Path(".")
+    suffix = f".tmp{out.suffix}"
+    room = name_max(parent) - len(os.fsencode(f"..{suffix}")) - 8  # mkstemp adds 8 random characters
+    if room < 0:  # a suffix of some 240 bytes: no muxer knows it anyway
+        suffix, room = ".tmp", name_max(parent) - 14
+    # cut in bytes (the limit's unit); a character cut in two decodes to surrogates, which encode
+    # back to the same bytes
+    stem = os.fsdecode(os.fsencode(out.stem)[:max(room, 0)])
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{stem}.", suffix=suffix, dir=parent)
+        os.close(fd)
+    except OSError as exc:
+        raise WallcliError(f"cannot create files in {parent}: {_reason(exc)}") from None
+    try:
+        os.chmod(name, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
+    except OSError as exc:
+        Path(name).unlink(missing_ok=True)
+        raise WallcliError(f"cannot write {out}: {_reason(exc)}") from None
+    return Path(name)
 
 
 def check_output(path: str | os.PathLike, *, force: bool = False, inputs: Iterable = ()) -> Path:
@@ -34,15 +126,12 @@ def check_output(path: str | os.PathLike, *, force: bool = False, inputs: Iterab
     for src in inputs:
         if src is not None and str(src) != "-" and _same_file(out, Path(str(src))):
             raise WallcliError(f"output {out} is the input; wallcli never overwrites an input")
+    _check_target(out, force=force)
     parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise WallcliError(f"output folder does not exist: {parent}")
-    if out.is_dir():
-        raise WallcliError(f"output is a folder: {out}")
-    if out.exists() and not force:
-        raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
     if not os.access(parent, os.W_OK):
         raise WallcliError(f"output folder is not writable: {parent}")
+    # the folder's permissions do not tell all (a read-only mount, /proc, /sys): try the real thing
+    _temporary(out).unlink(missing_ok=True)
     return out
 
 
@@ -59,6 +148,20 @@ def check_outputs(paths: Iterable, *, force: bool = False, inputs: Iterable = ()
                 raise UsageError(f"{out} is given for two outputs; each output needs its own file")
     inputs = list(inputs)
     return [check_output(out, force=force, inputs=inputs) for out in outs]
+
+
+def output_folder(path: str | os.PathLike) -> Path:
+    """Make (or reuse) a folder for outputs, and check files can be created in it, before any
+    work: a read-only mount or /proc is one clean line, not an internal error."""
+    folder = Path(path)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise WallcliError(f"output folder {folder} exists and is not a folder") from None
+    except OSError as exc:
+        raise WallcliError(f"cannot create the output folder {folder}: {_reason(exc)}") from None
+    _temporary(folder / "probe").unlink(missing_ok=True)
+    return folder
 
 
 @contextmanager
@@ -89,13 +192,17 @@ def atomic_paths(paths: Iterable, *, force: bool = False) -> Iterator[list[Path]
     tmps: list[Path] = []
     try:
         for out in outs:
-            check_output(out, force=force)
-            fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=f".tmp{out.suffix}", dir=out.parent or ".")
-            os.close(fd)
-            tmps.append(Path(tmp_name))
-            os.chmod(tmp_name, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
+            _check_target(out, force=force)
+            tmps.append(_temporary(out))
         yield list(tmps)
         raise_if_interrupted()  # a `kill` whose exception Python swallowed still places nothing
+    except OSError as exc:
+        _discard(tmps)
+        hit = [out for tmp, out in zip(tmps, outs) if _names_one_of(exc.filename, [tmp])]
+        if hit or exc.errno in _OUTPUT_ERRNOS:
+            target = hit[0] if hit else ", ".join(map(str, outs))
+            raise WallcliError(f"cannot write {target}: {_reason(exc)}") from None
+        raise
     except BaseException:
         _discard(tmps)
         raise
@@ -131,16 +238,30 @@ def committed_together() -> Iterator[None]:
     _commit(pending)
 
 
+def _names_one_of(filename, paths: Iterable[Path]) -> bool:
+    if filename is None:
+        return False
+    try:
+        return any(os.fsencode(filename) == os.fsencode(p) for p in paths)
+    except (TypeError, ValueError):
+        return False
+
+
 def _discard(paths: Iterable[Path]) -> None:
     for p in paths:
-        p.unlink(missing_ok=True)
+        try:
+            p.unlink(missing_ok=True)
+        except OSError:  # clearing up after a failure: the failure is what the user must hear of
+            pass
 
 
 def _commit(batches: list) -> None:
     """fsync every temporary, then rename each onto its output; on any failure remove them all,
     and the outputs already renamed (half a set is worse than none)."""
     tmps = [t for batch in batches for t in batch[0]]
+    outs_of = {t: o for batch_tmps, outs, _ in batches for t, o in zip(batch_tmps, outs)}
     placed: list[Path] = []
+    tmp = None
     try:
         raise_if_interrupted()
         for tmp in tmps:
@@ -148,12 +269,16 @@ def _commit(batches: list) -> None:
                 os.fsync(fh.fileno())
         for _, outs, force in batches:
             for out in outs:
-                if out.exists() and not force:  # someone else created it while we worked
-                    raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
+                # someone else created it (or put a device there) while we worked
+                _check_target(out, force=force)
         for batch_tmps, outs, _ in batches:
             for tmp, out in zip(batch_tmps, outs):
                 os.replace(tmp, out)
                 placed.append(out)
+    except OSError as exc:
+        _discard(tmps)
+        _discard(placed)
+        raise WallcliError(f"cannot write {outs_of.get(tmp, tmp)}: {_reason(exc)}") from None
     except BaseException:
         _discard(tmps)
         _discard(placed)

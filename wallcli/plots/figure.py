@@ -16,10 +16,18 @@ def new_figure(*args, **kwargs):
 
 def save_figure(fig, path, *, force: bool = False, dpi: int = 120) -> None:
     import matplotlib.pyplot as plt
+    from matplotlib.text import Text
 
+    from wallcli.io.text import escape_surrogates
     from wallcli.io.writer import atomic_path
 
     try:
+        # a file name that is not UTF-8 (titles name the input) holds lone surrogates, which
+        # matplotlib's font code refuses outright: shown escaped, as in the JSON
+        for text in fig.findobj(Text):
+            label = text.get_text()
+            if isinstance(label, str) and escape_surrogates(label) != label:
+                text.set_text(escape_surrogates(label))
         with atomic_path(path, force=force) as tmp:
             fig.savefig(tmp, dpi=dpi, format="png", bbox_inches="tight")
     finally:

@@ -46,11 +46,15 @@ def render(template: str, *, scripts: tuple[str, ...] = (), **context) -> str:
     """Render ``template`` with the shared style and the named scripts inlined (trusted package data)."""
     from wallcli import __version__
 
+    from wallcli.io.text import escape_surrogates
+
     style = asset("style.css")
     code = [asset(s) for s in scripts]
     context.setdefault("wallcli_version", __version__)
-    return environment().get_template(template).render(
-        csp=csp([style], code), style=Markup(style), scripts=[Markup(c) for c in code], **context)
+    # a file name that is not UTF-8 (in a title, a table, the command line) is shown escaped as in
+    # JSON: the page is UTF-8 and cannot hold its raw bytes
+    return escape_surrogates(environment().get_template(template).render(
+        csp=csp([style], code), style=Markup(style), scripts=[Markup(c) for c in code], **context))
 
 
 # ---------------------------------------------------------------------------- number filters

@@ -17,6 +17,7 @@ from wallcli.errors import WallcliError
 from wallcli.report.verdicts import answer
 
 TASKS = ("count", "activity")
+_STAND_IN = "_wallcli_stand_in"  # marks the record made for a line that is not one
 
 
 def _num(x) -> float | None:
@@ -46,11 +47,27 @@ def read_results(path: str | Path) -> tuple[list[dict[str, Any]], list[str]]:
             why = f"line {n} is not a JSON object"
         if not isinstance(rec, dict):
             problems.append(f"{path}: {why}")
-            rec = {"input": f"(line {n})", "error": why}
+            rec = {"input": f"(line {n})", "error": why, _STAND_IN: True}
         records.append(rec)
     if not records:
         raise WallcliError(f"{path} holds no results (expected one JSON object per line, as 'wallcli scan' writes)")
-    return records, problems
+    return _once_each(records, path, problems), problems
+
+
+def _once_each(records: list[dict[str, Any]], path, problems: list[str]) -> list[dict[str, Any]]:
+    """One record per video: the last line of each input counts. A scan replaces a video's line
+    when it redoes it, so a second line comes from two scans that appended at once (before scan
+    locked its file) or from results files put together; the later line is the newer."""
+    from wallcli.batch.results import key
+
+    keys = [key(r["input"]) if isinstance(r.get("input"), str) and not r.get(_STAND_IN) else None for r in records]
+    last = {k: i for i, k in enumerate(keys) if k is not None}
+    kept = [r for i, (r, k) in enumerate(zip(records, keys)) if k is None or last[k] == i]
+    repeated = len({k for i, k in enumerate(keys) if k is not None and last[k] != i})
+    if repeated:
+        problems.append(f"{path}: {repeated} video{'s' if repeated != 1 else ''} appear on more than one line; "
+                        "the last line of each is counted")
+    return kept
 
 
 def snr_figure(snr: Any) -> float | None:
