@@ -4,7 +4,8 @@
     python research/record_transfer.py models/count.onnx runs/transfer_count.json
 
 The card gains a ``transfer`` block: accuracy with its 95 % interval, coverage and accuracy of the
-decided answers, the confusion matrix and per-class figures, and the command that measured them.
+decided answers, the confusion matrix and per-class figures, the clips right by SNR band
+(``by_band``), and the command that measured them.
 The .onnx file is not touched (the card's sha256 covers only it); the card is checked to belong
 to the model that was measured, and rewritten atomically.
 """
@@ -18,7 +19,7 @@ from wallcli.infer.card import card_path, read_card, write_card
 from wallcli.io.writer import atomic_path
 
 KEYS = ("clips", "scored", "errors", "accuracy", "ci95", "decided", "coverage", "accuracy_decided",
-        "ci95_decided", "classes", "confusion", "per_class", "all")
+        "ci95_decided", "classes", "confusion", "per_class", "all", "snr_source", "by_band")
 
 
 def main() -> None:
@@ -30,7 +31,9 @@ def main() -> None:
     if result.get("model", {}).get("sha256") != card["sha256"]:
         raise SystemExit(f"{result_path} measured another model ({result.get('model')}), not {model}")
     # the set by what it is: the folder it sits in here means nothing to a reader of the card
-    block = {"description": f"independent path-traced transfer set, {result.get('scored')} clips (not shipped with wallcli)",
+    block = {"description": f"independent path-traced transfer set, {result.get('clips')} clips, the headline figures on "
+                            f"the {result.get('scored')} where the people are above the camera's noise or the room is "
+                            "empty, by_band on all (not shipped with wallcli)",
              **{k: result[k] for k in KEYS if k in result}}
     block["source"] = ("an independent path-traced renderer (other code, box people, area lights, its own camera "
                        "model), never trained or calibrated on")
