@@ -85,8 +85,7 @@ class _FakeReader:
         rng = np.random.default_rng(0)
         for i in range(self.n):
             rgb = 100.0 + rng.normal(0, 1, (24, 32, 3))
-            planes = SimpleNamespace(y=rgb[..., 0], u=rgb[..., 1], v=rgb[..., 2], sub_x=0, sub_y=0, width=32,
-                                     height=24, to_rgb=lambda r, g, b: np.stack([r, g, b], axis=-1))
+            planes = video.Planes(y=rgb[..., 0], u=rgb[..., 1], v=rgb[..., 2], kind="rgb")
             yield SimpleNamespace(index=i, time=i / 30.0, planes=planes)
 
 
