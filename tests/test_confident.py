@@ -11,9 +11,9 @@ FAR = ["--people", "1", "--activity", "waving", "--seed", "12", "--size", "96x72
        "--fps", "24", "--distance", "9,10", "--crf", "24", "--iso-gain", "1.0", "--read-noise", "3",
        "--sensor-pixels", "40000"]
 # What each shipped model decides, from its card's thresholds: activity certifies a strong walker;
-# count 0.4.1 certifies an empty room, never '1 person' (in calibration its one-person answers were
-# not 97 % right with 90 % confidence at any probability: models/README.md)
-DECIDED = {"count": ("empty", 0), "activity": ("strong", "walking")}
+# count 0.4.1's card certifies only 'nobody' on a quiet wall, which is never decided under the
+# noise (a person too faint to see looks the same), so count decides neither clip
+DECIDED = {"activity": ("strong", "walking")}
 
 
 @pytest.fixture(scope="module")
@@ -31,7 +31,7 @@ def clips(tmp_path_factory):
     return out
 
 
-@pytest.mark.parametrize("task", ["count", "activity"])
+@pytest.mark.parametrize("task", ["activity"])
 def test_a_clear_answer_is_decided_and_a_person_far_out_of_range_is_not(task, clips, run_cli):
     name, want = DECIDED[task]
     sure = json.loads(run_cli(task, clips[name], "--json")[1])
@@ -46,6 +46,16 @@ def test_a_clear_answer_is_decided_and_a_person_far_out_of_range_is_not(task, cl
     code, out, err = run_cli(task, clips["far"])
     flat = " ".join(out.split())  # the title wraps at the terminal width
     assert code == 0 and "= undetermined (" in flat and far["reason"].split(";")[0][:30] in flat
+
+
+def test_an_empty_wall_is_most_likely_nobody_but_not_decided(clips, run_cli):
+    """count says 0 for the empty room, undetermined: nobody moves above the noise, which a
+    person too faint to see would not either."""
+    r = json.loads(run_cli("count", clips["empty"], "--json")[1])
+    assert r["label"] == 0 and r["confident"] is False
+    assert "no movement above the camera's noise" in r["reason"]
+    code, out, _ = run_cli("count", clips["empty"])
+    assert code == 0 and "= undetermined (" in " ".join(out.split())
 
 
 def test_count_does_not_certify_what_it_gets_wrong(clips, run_cli):
