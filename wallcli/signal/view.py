@@ -1,0 +1,225 @@
+"""Is this a usable view: a static camera on a diffuse surface, with nothing visible moving?
+
+The method reads changes of 0.1-1 % of the wall's light; anything else that changes the picture
+(the camera moving, a person or object crossing the view, a cut to another shot, pixels clipped
+or crushed to black) is far larger and would be read as a hidden person. :class:`ViewCheck` is a
+tap on the one decode (fed frame by frame, memory independent of the clip's length) that flags
+frames where such things happen; :meth:`ViewCheck.view` says, for any time span, whether the view
+was usable there.
+
+Every threshold is in units of the noise the clip itself shows (frame-to-frame differences,
+robustly estimated), except two floors that encode the method's own premise: a hidden person
+changes the wall by a few per cent at most, so a change that is both far above the noise and over
+``REL`` of the local level is no hidden person; and a displacement under ``MIN_SHIFT`` pixels is
+the sub-pixel shake a tripod on a floor has, which corrections (not refusal) deal with.
+"""
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+
+MAX_SIDE = 320  # registration scale: finer texture than this is not needed to see a pan
+BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
+K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) is not noise
+K_CUT = 8.0
+REL = 0.05  # of the local level: above any hidden person's shadow
+CUT_FRACTION = 0.3  # of the usable blocks changing at once from one frame to the next
+MIN_MOVER_BLOCKS = 2
+MIN_SHIFT = 1.5  # source pixels from the reference frame
+K_SHIFT = 10.0  # z-score of the shift's fit against its mirror image (see _changes)
+DARK = 10.0  # 8-bit code values: 1 % of the level is then a tenth of a quantisation step
+CLIP_HI = 250.0
+MIN_USABLE = 0.5  # of the frame's area, neither clipped nor dark
+SIGMA_FLOOR = 0.02  # code values: a frozen (repeated) frame has no measurable noise
+HISTORY = 64  # frames whose noise estimates are pooled (a median: a cut or a mover does not move it)
+MAX_SPANS = 64  # per kind; more are merged, so memory stays bounded
+
+KINDS = {
+    "camera motion": "the camera moved",
+    "moving object": "something moved in view",
+    "scene cut": "the shot changes",
+    "clipped": "much of the frame is clipped",
+    "too dark": "much of the frame is too dark",
+    "too little usable area": "too little of the frame is usable",
+}
+
+
+def _grey(planes) -> np.ndarray:
+    """Luma of the frame as float32 on the 0-255 scale (what the wall's level is judged on)."""
+    scale = float(1 << (planes.depth - 8))
+    if planes.kind == "rgb":
+        y = (0.299 * planes.y.astype(np.float32) + 0.587 * planes.u + 0.114 * planes.v) / scale
+        return y.astype(np.float32)
+    y = planes.y.astype(np.float32) / np.float32(scale)
+    if not planes.full_range:
+        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
+    return y
+
+
+def _robust_sigma(d: np.ndarray) -> float:
+    """Sigma of one image from a difference of two: the RMS of the smallest 90 % of |d|, scaled to
+    a Gaussian's. Not the median: H.264 repeats static blocks exactly, so most differences of a
+    compressed wall are 0 and the median says 'no noise'; the trimmed tail keeps a mover out."""
+    a = np.abs(np.ravel(d) - np.median(d))
+    keep = a[a <= np.quantile(a, 0.9)]
+    return float(np.sqrt(np.mean(keep.astype(np.float64) ** 2) / 0.623 / 2.0)) if keep.size else 0.0
+
+
+def _highpass(img: np.ndarray) -> np.ndarray:
+    import cv2
+
+    return img - cv2.GaussianBlur(img, (0, 0), 4.0)
+
+
+class ViewCheck:
+    """Per-frame tests of the view, remembered as time spans per kind of issue.
+
+    Call it with decoded frames (a :class:`wallcli.io.video.FrameTee` tap) or :meth:`update` with
+    (time, planes). Nothing of the frame is kept but a few small downscaled images.
+    """
+
+    def __init__(self) -> None:
+        self.frames = 0
+        self.spans: dict[str, list[list[float]]] = {k: [] for k in KINDS}
+        self.max_shift = 0.0
+        self.min_usable = 1.0
+        self._sig_b: deque = deque(maxlen=HISTORY)
+        self._sig_h: deque = deque(maxlen=HISTORY)
+        self._prev_b = self._ref_b = self._prev_h = self._ref_h = None
+        self._t_prev = None
+        self._scale = 1.0
+        self._window = None
+
+    def __call__(self, frame) -> None:
+        self.update(frame.time, frame.planes)
+
+    # ------------------------------------------------------------------ per frame
+    def update(self, t: float, planes) -> None:
+        import cv2
+
+        grey = _grey(planes)
+        h, w = grey.shape
+        s = min(1.0, MAX_SIDE / max(h, w))
+        small = cv2.resize(grey, (max(1, round(w * s)), max(1, round(h * s))), interpolation=cv2.INTER_AREA) \
+            if s < 1 else grey
+        self._scale = 1.0 / (small.shape[1] / w)
+        bw = BLOCKS if w >= h else max(4, round(BLOCKS * w / h))
+        bh = max(4, round(bw * h / w))
+        blocks = cv2.resize(small, (bw, bh), interpolation=cv2.INTER_AREA)
+        clipped = cv2.resize((small >= CLIP_HI).astype(np.float32), (bw, bh), interpolation=cv2.INTER_AREA) > 0.01
+        dark = (blocks < DARK) & ~clipped
+        ok = ~(clipped | dark)
+        usable = float(ok.mean())
+        self.min_usable = min(self.min_usable, usable)
+        flags = set()
+        if usable < MIN_USABLE:
+            flags.add("too little usable area")
+            if clipped.mean() >= (1 - MIN_USABLE) / 2:
+                flags.add("clipped")
+            if dark.mean() >= (1 - MIN_USABLE) / 2:
+                flags.add("too dark")
+        hp = _highpass(small)
+        if self._prev_b is None:
+            self._reset(blocks, hp)
+        else:
+            flags |= self._changes(t, blocks, hp, ok)
+        self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
+        self.frames += 1
+        for kind in flags:
+            self._mark(kind, t)
+
+    def _reset(self, blocks, hp) -> None:
+        self._ref_b, self._ref_h = blocks.copy(), hp
+
+    def _changes(self, t, blocks, hp, ok) -> set:
+        import cv2
+
+        flags = set()
+        if not ok.any():
+            return flags
+        prev, ref = self._prev_b, self._ref_b
+        d = blocks - prev
+        self._sig_b.append(_robust_sigma(d[ok]))
+        self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2)
+        sigma = max(float(np.median(self._sig_b)), SIGMA_FLOOR)
+        var_h = max(float(np.median(self._sig_h)), SIGMA_FLOOR ** 2)
+        level = np.maximum(blocks, DARK)
+        # a cut: most of the frame changes at once, beyond a whole-frame gain (exposure, flicker)
+        gain = float(np.median(blocks[ok] / np.maximum(prev[ok], 1e-3)))
+        jump = np.abs(blocks - gain * prev) > np.maximum(K_CUT * sigma * np.sqrt(2.0), REL * level)
+        if jump[ok].mean() > CUT_FRACTION:
+            flags.add("scene cut")
+            self._sig_b.pop()
+            self._sig_h.pop()
+            self._reset(blocks, hp)
+            return flags
+        # camera motion: a shift of the frame's fine structure against the reference frame that
+        # explains more of the change than the noise could
+        if self._window is None or self._window.shape != hp.shape:
+            self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
+        # copies: OpenCV applies the window to its inputs in place
+        (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
+        shift = float(np.hypot(dx, dy)) * self._scale
+        moved = False
+        if shift >= MIN_SHIFT:
+            # the reference moved by +s must fit far better than moved by -s: both warps smooth
+            # its noise alike, so only a real shift of shared structure separates them; the
+            # spread of the difference of two means of N squared residuals is var*sqrt(8/N),
+            # N counted as a quarter of the pixels (interpolation and compression correlate them)
+            c = slice(8, -8)
+            e = []
+            for sg in (1, -1):
+                m = np.float32([[1, 0, sg * dx], [0, 1, sg * dy]])
+                warped = cv2.warpAffine(self._ref_h, m, hp.shape[::-1], borderMode=cv2.BORDER_REFLECT)
+                e.append(float(np.mean((hp - warped)[c, c] ** 2)))
+            n = hp[c, c].size / 4
+            moved = (e[1] - e[0]) > K_SHIFT * var_h * np.sqrt(8.0 / n)
+        if moved:
+            flags.add("camera motion")
+            self.max_shift = max(self.max_shift, shift)
+        # something in view: a compact change far above the noise against the slow background,
+        # once the whole-frame gain and the broad light changes (a hidden person's) are taken out
+        g = float(np.median(blocks[ok] / np.maximum(ref[ok], 1e-3)))
+        r = blocks - g * ref
+        r = r - cv2.GaussianBlur(r, (0, 0), 2.0)
+        hit = (np.abs(r) > np.maximum(K_MOVER * sigma, REL * level)) & ok
+        if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
+            flags.add("moving object")
+        a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
+        self._ref_b = ((1 - a) * ref + a * blocks / max(g, 1e-3)).astype(np.float32)
+        return flags
+
+    def _mark(self, kind: str, t: float) -> None:
+        spans = self.spans[kind]
+        if spans and (t - spans[-1][1] < 0.5 or len(spans) >= MAX_SPANS):
+            spans[-1][1] = t
+        else:
+            spans.append([t, t])
+
+    # ------------------------------------------------------------------ verdicts
+    def view(self, start: float | None = None, end: float | None = None) -> dict:
+        """``{"usable", "issues", "reason"}`` over [start, end] seconds (the whole clip: no bounds)."""
+        lo = -np.inf if start is None else start
+        hi = np.inf if end is None else end
+        found = {k: [s for s in spans if s[1] >= lo and s[0] <= hi] for k, spans in self.spans.items()}
+        issues = [k for k, s in found.items() if s]
+        if self.frames == 0:
+            return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked"}
+        reason = None
+        if issues:
+            parts = [f"{k} at {_spans_text(found[k])}" for k in issues]
+            reason = "not a static view of the wall: " + "; ".join(parts)
+        return {"usable": not issues, "issues": issues, "reason": reason}
+
+    def summary(self) -> dict:
+        """The clip's view and what it was judged on (extra fields of the JSON's ``view``)."""
+        noise = float(np.median(self._sig_b)) if self._sig_b else None
+        return {**self.view(), "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
+                "min_usable_area": round(self.min_usable, 3),
+                "noise": None if noise is None else round(noise, 4)}
+
+
+def _spans_text(spans: list) -> str:
+    shown = ", ".join(f"{a:.1f}-{b:.1f} s" if b > a else f"{a:.1f} s" for a, b in spans[:3])
+    return shown + (f" and {len(spans) - 3} more" if len(spans) > 3 else "")
