@@ -21,7 +21,10 @@ import numpy as np
 
 MAX_SIDE = 320  # registration scale: finer texture than this is not needed to see a pan
 BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
-K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) is not noise
+K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) from its slow background
+REL_EDGE = 0.10  # whose fine structure changed by an RMS over this fraction of the level
+FINE = 2.0  # pixels (at the registration scale): the outline's scale
+EDGE_LEVEL = 40.0  # code values: under it, the level floor (noise, not contrast, rules dark walls)
 K_CUT = 8.0
 REL = 0.05  # of the local level: above any hidden person's shadow
 CUT_FRACTION = 0.3  # of the usable blocks changing at once from one frame to the next
@@ -66,10 +69,10 @@ def _robust_sigma(d: np.ndarray) -> float:
     return float(np.sqrt(np.mean(keep.astype(np.float64) ** 2) / 0.623 / 2.0)) if keep.size else 0.0
 
 
-def _highpass(img: np.ndarray) -> np.ndarray:
+def _highpass(img: np.ndarray, sigma: float = 4.0) -> np.ndarray:
     import cv2
 
-    return img - cv2.GaussianBlur(img, (0, 0), 4.0)
+    return img - cv2.GaussianBlur(img, (0, 0), sigma)
 
 
 class ViewCheck:
@@ -79,14 +82,15 @@ class ViewCheck:
     (time, planes). Nothing of the frame is kept but a few small downscaled images.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, roi=None) -> None:
+        self.roi = roi  # (x, y, w, h): only what the analysis reads needs to be a still wall
         self.frames = 0
         self.spans: dict[str, list[list[float]]] = {k: [] for k in KINDS}
         self.max_shift = 0.0
         self.min_usable = 1.0
         self._sig_b: deque = deque(maxlen=HISTORY)
         self._sig_h: deque = deque(maxlen=HISTORY)
-        self._prev_b = self._ref_b = self._prev_h = self._ref_h = None
+        self._prev_b = self._prev_h = self._ref_h = self._bg_h = self._bg_b = None
         self._t_prev = None
         self._scale = 1.0
         self._window = None
@@ -99,6 +103,10 @@ class ViewCheck:
         import cv2
 
         grey = _grey(planes)
+        if self.roi is not None:
+            x, y, w, h = self.roi
+            crop = grey[y:y + h, x:x + w]
+            grey = crop if min(crop.shape) >= 8 else grey  # a bad ROI is the reader's error to give
         h, w = grey.shape
         s = min(1.0, MAX_SIDE / max(h, w))
         small = cv2.resize(grey, (max(1, round(w * s)), max(1, round(h * s))), interpolation=cv2.INTER_AREA) \
@@ -121,24 +129,24 @@ class ViewCheck:
                 flags.add("too dark")
         hp = _highpass(small)
         if self._prev_b is None:
-            self._reset(blocks, hp)
+            self._reset(hp, small, blocks)
         else:
-            flags |= self._changes(t, blocks, hp, ok)
+            flags |= self._changes(t, blocks, hp, ok, small)
         self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
         self.frames += 1
         for kind in flags:
             self._mark(kind, t)
 
-    def _reset(self, blocks, hp) -> None:
-        self._ref_b, self._ref_h = blocks.copy(), hp
+    def _reset(self, hp, small, blocks) -> None:
+        self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
 
-    def _changes(self, t, blocks, hp, ok) -> set:
+    def _changes(self, t, blocks, hp, ok, small) -> set:
         import cv2
 
         flags = set()
         if not ok.any():
             return flags
-        prev, ref = self._prev_b, self._ref_b
+        prev = self._prev_b
         d = blocks - prev
         self._sig_b.append(_robust_sigma(d[ok]))
         self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2)
@@ -152,7 +160,7 @@ class ViewCheck:
             flags.add("scene cut")
             self._sig_b.pop()
             self._sig_h.pop()
-            self._reset(blocks, hp)
+            self._reset(hp, small, blocks)
             return flags
         # camera motion: a shift of the frame's fine structure against the reference frame that
         # explains more of the change than the noise could
@@ -178,16 +186,23 @@ class ViewCheck:
         if moved:
             flags.add("camera motion")
             self.max_shift = max(self.max_shift, shift)
-        # something in view: a compact change far above the noise against the slow background,
-        # once the whole-frame gain and the broad light changes (a hidden person's) are taken out
-        g = float(np.median(blocks[ok] / np.maximum(ref[ok], 1e-3)))
-        r = blocks - g * ref
-        r = r - cv2.GaussianBlur(r, (0, 0), 2.0)
-        hit = (np.abs(r) > np.maximum(K_MOVER * sigma, REL * level)) & ok
+        # something in view: a block far brighter or darker than its slow background (beyond
+        # the noise and beyond any hidden person's few per cent) whose fine structure changed
+        # too (an object's outline); a hidden person's shadow, even a hard one from a window, has
+        # edges blurred by its penumbra and changes the fine scale far less
+        a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
+        g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
+        broad = np.abs(blocks - g * self._bg_b) > np.maximum(K_MOVER * sigma, REL * level)
+        fine = _highpass(small, FINE)
+        # light falling on the wall scales its texture with it: compare with the background's
+        # texture scaled by each block's change of level, so a shadow's dimming is not an outline
+        scale = cv2.resize(blocks / np.maximum(g * self._bg_b, 1.0), fine.shape[::-1], interpolation=cv2.INTER_LINEAR)
+        energy = cv2.resize((fine - scale * self._bg_h) ** 2, blocks.shape[::-1], interpolation=cv2.INTER_AREA)
+        hit = broad & (np.sqrt(energy) > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & ok
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
-        a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
-        self._ref_b = ((1 - a) * ref + a * blocks / max(g, 1e-3)).astype(np.float32)
+        self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
+        self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
         return flags
 
     def _mark(self, kind: str, t: float) -> None:

@@ -45,7 +45,7 @@ def sprite(frames: Iterable[np.ndarray], rng, *, n: int, fps: float, contrast=(0
             x = (-w + u * (W + 2 * w)) if left else (W + w - u * (W + 2 * w))
             mask = np.zeros((H, W), np.float32)
             cv2.ellipse(mask, (int(x), int(y)), (int(w / 2), int(h / 2)), 0, 0, 360, 1.0, -1)
-            mask = cv2.GaussianBlur(mask, (0, 0), 1.5)[..., None]
+            mask = cv2.GaussianBlur(mask, (0, 0), 0.7)[..., None]  # an in-focus outline: a pixel or two
             f = np.clip(f * (1 - mask) + colour * mask + 0.5, 0, 255).astype(np.uint8)
         yield f
         i += 1
