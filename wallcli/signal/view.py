@@ -64,6 +64,8 @@ def _robust_sigma(d: np.ndarray) -> float:
     """Sigma of one image from a difference of two: the RMS of the smallest 90 % of |d|, scaled to
     a Gaussian's. Not the median: H.264 repeats static blocks exactly, so most differences of a
     compressed wall are 0 and the median says 'no noise'; the trimmed tail keeps a mover out."""
+    if d.size == 0:
+        return 0.0
     a = np.abs(np.ravel(d) - np.median(d))
     keep = a[a <= np.quantile(a, 0.9)]
     return float(np.sqrt(np.mean(keep.astype(np.float64) ** 2) / 0.623 / 2.0)) if keep.size else 0.0
@@ -149,7 +151,7 @@ class ViewCheck:
         prev = self._prev_b
         d = blocks - prev
         self._sig_b.append(_robust_sigma(d[ok]))
-        self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2)
+        self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2 if min(hp.shape) > 8 else 0.0)
         sigma = max(float(np.median(self._sig_b)), SIGMA_FLOOR)
         var_h = max(float(np.median(self._sig_h)), SIGMA_FLOOR ** 2)
         level = np.maximum(blocks, DARK)
@@ -170,7 +172,7 @@ class ViewCheck:
         (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
         shift = float(np.hypot(dx, dy)) * self._scale
         moved = False
-        if shift >= MIN_SHIFT:
+        if shift >= MIN_SHIFT and min(hp.shape) > 32:  # smaller: no structure to register on
             # the reference moved by +s must fit far better than moved by -s: both warps smooth
             # its noise alike, so only a real shift of shared structure separates them; the
             # spread of the difference of two means of N squared residuals is var*sqrt(8/N),
