@@ -30,7 +30,10 @@ REL = 0.05  # of the local level: above any hidden person's shadow
 CUT_FRACTION = 0.3  # of the usable blocks changing at once from one frame to the next
 MIN_MOVER_BLOCKS = 2
 MIN_SHIFT = 1.5  # source pixels from the reference frame
-K_SHIFT = 10.0  # z-score of the shift's fit against its mirror image (see _changes)
+K_SHIFT = 3.0  # z-score of the shift's fit against its mirror image (see _changes), held over
+HOLD, HOLD_WITHIN = 3, 8  # agreeing frames among the last few: the phase correlation picks the best
+# of many shifts, so noise alone scores a few, but its peaks land anywhere; on a noisy wall the
+# true peak wins only in some frames, so agreement is asked of 3 of 8, not of 3 in a row
 DARK = 10.0  # 8-bit code values: 1 % of the level is then a tenth of a quantisation step
 CLIP_HI = 250.0
 MIN_USABLE = 0.5  # of the frame's area, neither clipped nor dark
@@ -96,6 +99,7 @@ class ViewCheck:
         self._t_prev = None
         self._scale = 1.0
         self._window = None
+        self._shifts: deque = deque(maxlen=HOLD_WITHIN)  # recent significant shifts (inf: none)
 
     def __call__(self, frame) -> None:
         self.update(frame.time, frame.planes)
@@ -129,7 +133,8 @@ class ViewCheck:
                 flags.add("clipped")
             if dark.mean() >= (1 - MIN_USABLE) / 2:
                 flags.add("too dark")
-        hp = _highpass(small)
+        # registration reads a band: finer is mostly noise and codec residue, coarser is light
+        hp = cv2.GaussianBlur(small, (0, 0), 1.5) - cv2.GaussianBlur(small, (0, 0), 8.0)
         if self._prev_b is None:
             self._reset(hp, small, blocks)
         else:
@@ -175,8 +180,10 @@ class ViewCheck:
         if shift >= MIN_SHIFT and min(hp.shape) > 32:  # smaller: no structure to register on
             # the reference moved by +s must fit far better than moved by -s: both warps smooth
             # its noise alike, so only a real shift of shared structure separates them; the
-            # spread of the difference of two means of N squared residuals is var*sqrt(8/N),
-            # N counted as a quarter of the pixels (interpolation and compression correlate them)
+            # spread of the difference of two means of N squared residuals is e*sqrt(8/N), N
+            # counted as a quarter of the pixels (interpolation and compression correlate them).
+            # e is the residual itself, not the frame-to-frame noise: a codec that repeats static
+            # blocks makes consecutive frames alike but not the reference's texture
             c = slice(8, -8)
             e = []
             for sg in (1, -1):
@@ -184,7 +191,15 @@ class ViewCheck:
                 warped = cv2.warpAffine(self._ref_h, m, hp.shape[::-1], borderMode=cv2.BORDER_REFLECT)
                 e.append(float(np.mean((hp - warped)[c, c] ** 2)))
             n = hp[c, c].size / 4
-            moved = (e[1] - e[0]) > K_SHIFT * var_h * np.sqrt(8.0 / n)
+            fits = (e[1] - e[0]) > K_SHIFT * max(e[0], var_h) * np.sqrt(8.0 / n)
+            # and it must hold from one frame to the next: a camera moves smoothly, while the
+            # correlation peaks of noise land anywhere
+            if fits:
+                near = [1 for x, y in self._shifts if np.hypot(dx - x, dy - y) * self._scale < 1.0]
+                moved = len(near) + 1 >= HOLD
+            self._shifts.append((dx, dy) if fits else (np.inf, np.inf))
+        else:
+            self._shifts.append((np.inf, np.inf))
         if moved:
             flags.add("camera motion")
             self.max_shift = max(self.max_shift, shift)
