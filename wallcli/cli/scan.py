@@ -97,8 +97,8 @@ def scan(
         from wallcli.errors import WallcliError
 
         first, why = state["unusable"][0]
-        raise WallcliError(f"{plural(len(state['unusable']), 'video')} scanned now not a static view of a wall "
-                           f"(--strict; every line is written): {first}: {why}")
+        raise WallcliError(f"{plural(len(state['unusable']), 'video')} of this run not a static view of a wall "
+                           f"(--strict; every line is written), first {first}: {why}")
 
 
 class _Bar:
