@@ -186,6 +186,8 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         return
     for n in notes:
         warn(n)
+    if not result["view"]["usable"]:  # the figures below then measure more than a wall's light
+        warn(result["view"]["reason"])
     how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
