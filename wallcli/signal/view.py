@@ -27,7 +27,8 @@ FINE = 2.0  # pixels (at the registration scale): the outline's scale
 EDGE_LEVEL = 40.0  # code values: under it, the level floor (noise, not contrast, rules dark walls)
 K_CUT = 8.0
 REL = 0.05  # of the local level: above any hidden person's shadow
-CUT_FRACTION = 0.3  # of the usable blocks changing at once from one frame to the next
+REL_CUT = 0.02  # one frame to the next: a shadow moves, it does not change a fifth of the wall at once
+CUT_FRACTION = 0.2  # of the usable blocks (simulated walls: at most 1.5 %; cuts between two: 40 % and more)
 MIN_MOVER_BLOCKS = 2
 MIN_SHIFT = 1.5  # source pixels from the reference frame
 K_SHIFT = 3.0  # z-score of the shift's fit against its mirror image (see _changes), held over
@@ -162,7 +163,7 @@ class ViewCheck:
         level = np.maximum(blocks, DARK)
         # a cut: most of the frame changes at once, beyond a whole-frame gain (exposure, flicker)
         gain = float(np.median(blocks[ok] / np.maximum(prev[ok], 1e-3)))
-        jump = np.abs(blocks - gain * prev) > np.maximum(K_CUT * sigma * np.sqrt(2.0), REL * level)
+        jump = np.abs(blocks - gain * prev) > np.maximum(K_CUT * sigma * np.sqrt(2.0), REL_CUT * level)
         if jump[ok].mean() > CUT_FRACTION:
             flags.add("scene cut")
             self._sig_b.pop()
