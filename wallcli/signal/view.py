@@ -29,6 +29,7 @@ K_CUT = 8.0
 REL = 0.05  # of the local level: above any hidden person's shadow
 REL_CUT = 0.02  # one frame to the next: a shadow moves, it does not change a fifth of the wall at once
 CUT_FRACTION = 0.2  # of the usable blocks (simulated walls: at most 1.5 %; cuts between two: 40 % and more)
+CUT_CALM = 0.05  # the frames before and after a cut
 MIN_MOVER_BLOCKS = 2
 MIN_SHIFT = 1.5  # source pixels from the reference frame
 K_SHIFT = 3.0  # z-score of the shift's fit against its mirror image (see _changes), held over
@@ -100,6 +101,7 @@ class ViewCheck:
         self._t_prev = None
         self._scale = 1.0
         self._window = None
+        self._fracs = (1.0, 1.0)  # changed shares of the last two frames (none calm before the first)
         self._shifts: deque = deque(maxlen=HOLD_WITHIN)  # recent significant shifts (inf: none)
 
     def __call__(self, frame) -> None:
@@ -161,13 +163,16 @@ class ViewCheck:
         sigma = max(float(np.median(self._sig_b)), SIGMA_FLOOR)
         var_h = max(float(np.median(self._sig_h)), SIGMA_FLOOR ** 2)
         level = np.maximum(blocks, DARK)
-        # a cut: most of the frame changes at once, beyond a whole-frame gain (exposure, flicker)
+        # a cut: much of the frame changes from one frame to the next, beyond a whole-frame gain
+        # (exposure, flicker), with calm frames on either side (a hard shadow sweeping the wall
+        # changes as much, but over several frames); judged one frame late, on the previous one
         gain = float(np.median(blocks[ok] / np.maximum(prev[ok], 1e-3)))
         jump = np.abs(blocks - gain * prev) > np.maximum(K_CUT * sigma * np.sqrt(2.0), REL_CUT * level)
-        if jump[ok].mean() > CUT_FRACTION:
-            flags.add("scene cut")
-            self._sig_b.pop()
-            self._sig_h.pop()
+        frac = float(jump[ok].mean())
+        before = self._fracs
+        self._fracs = (before[1], frac)
+        if before[1] > CUT_FRACTION and before[0] < CUT_CALM and frac < CUT_CALM:
+            self._mark("scene cut", self._t_prev)
             self._reset(hp, small, blocks)
             return flags
         # camera motion: a shift of the frame's fine structure against the reference frame that
