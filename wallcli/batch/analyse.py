@@ -29,7 +29,7 @@ class _Tee:
 
 def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
             on_frame: Callable[[], None] | None = None) -> dict[str, Any]:
-    """``{"frames", "duration", "fps", "warnings", <task>: <its --json object>, ...}`` for ``source``.
+    """``{"frames", "duration", "fps", "warnings", "view", <task>: <its --json object>, ...}`` for ``source``.
 
     ``models``: a loaded :class:`~wallcli.infer.model.Model` per classification task asked for.
     ``on_frame`` is called after every decoded frame (a watchdog's heartbeat; it may raise to
@@ -37,11 +37,12 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     task: a video either has every answer asked for or none.
     """
     from wallcli.errors import WallcliError
-    from wallcli.infer.classify import WindowClassifier
+    from wallcli.infer.classify import WindowClassifier, with_view
     from wallcli.infer.stream import RowStream
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.snr import SnrAccumulator, snr_report
+    from wallcli.signal.view import ViewCheck
 
     classify = [t for t in CLASSIFY if t in tasks]
     used = [models[t] for t in classify]
@@ -53,7 +54,10 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         info = reader.info
         snr = SnrAccumulator(check_roi(None, info.width, info.height)) if "snr" in tasks else None
 
+        check = ViewCheck()
+
         def each(frame) -> None:
+            check(frame)
             if snr is not None:
                 snr.update(frame.planes)
             state["frames"] += 1
@@ -75,9 +79,9 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         fps = float(info.fps)
         notes = list(reader.warnings)
     out: dict[str, Any] = {"frames": state["frames"], "duration": round(state["last"] + 1.0 / fps, 6), "fps": fps,
-                           "warnings": notes}
+                           "warnings": notes, "view": check.summary()}
     for task, c in zip(classify, classifiers):
-        out[task] = c.result(source)
+        out[task] = with_view(c.result(source), check)
     if snr is not None:
-        out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame")
+        out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
     return out

@@ -52,7 +52,8 @@ def csv_columns(tasks, classes: dict[str, list], windows: bool = False) -> list[
         cols += ["snr.roi", "snr.frames"]
         cols += [f"snr.{q}.{c}" for q in ("signal_power", "noise_power", "snr_db") for c in CHANNELS]
         cols += ["snr.sampled_pixels", "snr.exact", "snr.scales"]
-    return cols
+    # the view check's verdict, whatever the tasks (it rides on every decode)
+    return cols + ["view.usable", "view.issues", "view.reason"]
 
 
 def _cell(value: Any) -> str:
@@ -82,6 +83,8 @@ def flatten(line: dict, columns: list[str]) -> list[str]:
     them; whatever is not a column (the full objects' other fields) is left to the JSON format."""
     flat: dict[str, Any] = {k: line.get(k) for k in BASE}
     flat["tasks"] = ",".join(line.get("tasks") or [])
+    if isinstance(line.get("view"), dict):
+        flat.update({f"view.{k}": v for k, v in line["view"].items()})
     for task in ("count", "activity", "snr"):
         obj = line.get(task)
         if not isinstance(obj, dict):

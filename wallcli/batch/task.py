@@ -163,6 +163,7 @@ def scan_video(source: str, config: ScanConfig) -> dict[str, Any]:
         if task in CLASSIFY and not config.windows:
             obj.pop("windows", None)
         line[task] = obj
+    line["view"] = out["view"]
     line["warnings"] = out["warnings"]
     line["seconds"] = round(time.perf_counter() - t0, 3)
     line["error"] = None

@@ -10,7 +10,8 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import (ROI_HELP, force_help, input_argument, number_option, parse_roi, refuse_view,
+                                strict_option, threads_option)
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
@@ -24,10 +25,12 @@ FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print 
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
 FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
 INPUT_ARG = input_argument(INPUT_HELP)
+STRICT_OPT = strict_option()
 
 
 def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
-        model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool) -> None:
+        model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
+        strict: bool = False) -> None:
     from wallcli.errors import UsageError
 
     roi_t = parse_roi(roi)
@@ -49,6 +52,8 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         from wallcli.infer.classify import follow as follow_windows
 
         for rec in follow_windows(model, input, stride=stride, roi=roi_t):
+            if strict:
+                refuse_view(input, rec.get("view"))
             emit_json(rec)
         return
 
@@ -63,6 +68,8 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         with progress(task, None) as advance:
             result, st = classify_video(model, input, stride=stride, roi=roi_t,
                                         progress=advance, keep_plot=plot is not None)
+    if strict:
+        refuse_view(input, result.get("view"))
     with committed_together():  # the figure and the data on stdout: all or none
         _report(task, input, model, result, st, plot, json_out, force)
     from wallcli.cli.output import wrote

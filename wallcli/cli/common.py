@@ -113,3 +113,20 @@ def input_argument(help_text: str = "Video file, http(s)/rtsp URL, or '-' for a 
 
 def is_npz(path: str) -> bool:
     return str(path).lower().endswith(".npz")
+
+
+STRICT_HELP = ("Exit 1 when the view check finds the video is not a static view of a wall (camera motion, "
+               "something moving in view, a cut, too little usable area). Without it such answers are "
+               "undetermined, with the reason, and the exit status is 0.")
+
+
+def strict_option():
+    return typer.Option(False, "--strict", help=STRICT_HELP)
+
+
+def refuse_view(source, view) -> None:
+    """Under --strict: an unusable view is the input's error (exit 1, one line)."""
+    if view and not view.get("usable", True):
+        from wallcli.errors import WallcliError
+
+        raise WallcliError(f"{source}: {view.get('reason') or 'not a static view of the wall'} (--strict)")

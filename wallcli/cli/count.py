@@ -5,7 +5,7 @@ from pathlib import Path
 from typing import Optional
 
 from wallcli.cli._classify import (FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
-                                   STRIDE_OPT, THREADS_OPT, run)
+                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, run)
 
 
 def count(
@@ -18,6 +18,7 @@ def count(
     follow: bool = FOLLOW_OPT,
     roi: Optional[str] = ROI_OPT,
     force: bool = FORCE_OPT,
+    strict: bool = STRICT_OPT,
 ) -> None:
     """Count the people (0, 1 or 2) moving out of view, from the light on a blank wall.
 
@@ -34,4 +35,4 @@ def count(
       ffmpeg -i rtsp://cam/stream -f nut - | wallcli count - --follow
     """
     run("count", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
-        follow=follow, roi=roi, force=force)
+        follow=follow, roi=roi, force=force, strict=strict)

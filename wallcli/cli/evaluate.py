@@ -6,7 +6,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import MAX_THREADS, ROI_HELP, force_help, number_option
+from wallcli.cli.common import MAX_THREADS, ROI_HELP, force_help, number_option, strict_option
 
 PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
 
@@ -29,6 +29,7 @@ def evaluate(
                                              "at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG, the only file evaluate writes,")),
+    strict: bool = strict_option(),
 ) -> None:
     """Score a model on labelled clips: the check to run before relying on it for a room.
 
@@ -84,7 +85,13 @@ def evaluate(
         save_reliability_png(plot, result, force=force)
     if json_out:
         emit_json(result)
-        return
-    from wallcli.cli._evaluate_table import print_evaluation
+    else:
+        from wallcli.cli._evaluate_table import print_evaluation
 
-    print_evaluation(result)
+        print_evaluation(result)
+    bad = [r for r in result["rows"] if not (r.get("view") or {}).get("usable", True)]
+    if strict and bad:
+        from wallcli.errors import WallcliError
+
+        raise WallcliError(f"{len(bad)} clip(s) not a static view of a wall (--strict; the figures above include "
+                           f"them as undetermined): {bad[0]['file']}: {bad[0]['view']['reason']}")

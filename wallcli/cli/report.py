@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, parse_roi, threads_option
+from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, parse_roi, refuse_view, strict_option, threads_option
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
 
@@ -21,6 +21,7 @@ def report(
     activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
     force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
+    strict: bool = strict_option(),
 ) -> None:
     """Write one HTML page that opens offline in any browser and can be handed over as it is.
 
@@ -75,6 +76,8 @@ def report(
         models = load_models(count_model, activity_model)
         with progress("report", None) as advance:
             analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance)
+        if strict:
+            refuse_view(input, analysis.view)
         for w in analysis.warnings:
             warn(w)
         for task, why in analysis.failures.items():

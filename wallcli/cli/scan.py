@@ -7,7 +7,7 @@ from typing import List, Optional
 
 import typer
 
-from wallcli.cli.common import MAX_THREADS, number_option
+from wallcli.cli.common import MAX_THREADS, number_option, strict_option
 
 
 def scan(
@@ -34,6 +34,7 @@ def scan(
     timeout: float = number_option(300.0, "--timeout", lo=0, hi=86400, help="Give a video up (an error line) when its decoder "
                                   "produces no frame for this many seconds. 0: wait forever."),
     json_out: bool = typer.Option(False, "--json", help="Print the run's summary as one JSON object on stdout."),
+    strict: bool = strict_option(),
 ) -> None:
     """Analyse many videos into one results file: one line per video, as each finishes.
 
@@ -66,9 +67,12 @@ def scan(
 
         raise UsageError("--workers sizes the cluster on this machine; a --scheduler has its own workers")
     debug = os.environ.get("WALLCLI_DEBUG", "") not in ("", "0")
-    state = {"hours": 0.0, "failed": 0}
+    state = {"hours": 0.0, "failed": 0, "unusable": []}
 
     def on_line(line: dict) -> None:
+        view = line.get("view") or {}
+        if not view.get("usable", True):
+            state["unusable"].append((line["input"], view.get("reason")))
         if line.get("error") is None:
             state["hours"] += float(line.get("duration") or 0.0) / 3600.0
         else:
@@ -89,6 +93,12 @@ def scan(
         f"({summary['videos_per_second']:.2f} videos/s) -> {summary['output']}", wrap=False)
     if json_out:
         emit_json(summary)
+    if strict and state["unusable"]:
+        from wallcli.errors import WallcliError
+
+        first, why = state["unusable"][0]
+        raise WallcliError(f"{plural(len(state['unusable']), 'video')} of this run not a static view of a wall "
+                           f"(--strict; every line is written), first {first}: {why}")
 
 
 class _Bar:

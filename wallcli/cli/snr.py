@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import THREADS_HELP, Number, force_help, number_option, threads_option
+from wallcli.cli.common import THREADS_HELP, Number, force_help, number_option, strict_option, threads_option
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
 # checks the option and every value of a --sweep alike.
@@ -74,6 +74,7 @@ def snr(
     frames: float = _predict_option("frames"),
     force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
+    strict: bool = strict_option(),
 ) -> None:
     """Measure the wall signal and the noise in a video, per colour channel (Sharma et al., What
     You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §3.2).
@@ -108,11 +109,11 @@ def snr(
         raise UsageError("--sweep goes with --predict")
     with committed_together():
         _measure(input, roi=roi, json_out=json_out, heatmap=heatmap, heatmap_of=heatmap_of, plot=plot,
-                 max_pixels=max_pixels, force=force, threads=threads)
+                 max_pixels=max_pixels, force=force, threads=threads, strict=strict)
 
 
 # ------------------------------------------------------------------------------------- measure
-def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, force, threads) -> None:
+def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, force, threads, strict=False) -> None:
     import warnings
 
     from wallcli.cli.common import parse_roi
@@ -122,6 +123,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.snr import GridAccumulator, SnrAccumulator, snr_db, snr_report
+    from wallcli.signal.view import ViewCheck
     from wallcli.wording import format_db
 
     auto = roi is not None and roi.strip().lower() == "auto"
@@ -148,9 +150,11 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         if heatmap is not None and grid is None:
             grid = GridAccumulator(roi_c, 48)
         feed_grid = grid if (grid is not None and not auto) else None
+        check = ViewCheck(roi_c)
         with progress("snr", reader.info.frame_count) as advance:
             for frame in reader.frames():
                 acc.update(frame.planes)
+                check(frame)
                 if feed_grid is not None:
                     feed_grid.update(frame.planes)
                 advance()
@@ -158,6 +162,11 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     notes += [str(w.message) for w in caught]
     result = snr_report(acc, source=input, fps=fps, notes=notes,
                         roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))
+    result["view"] = check.summary()
+    if strict:
+        from wallcli.cli.common import refuse_view
+
+        refuse_view(input, result["view"])
     res = acc.result()
     notes = result["warnings"]
     if auto:
@@ -177,6 +186,8 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         return
     for n in notes:
         warn(n)
+    if not result["view"]["usable"]:  # the figures below then measure more than a wall's light
+        warn(result["view"]["reason"])
     how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "

@@ -125,6 +125,7 @@ def _row(clip: Clip, out: dict, task: str, has_snr: bool) -> dict[str, Any]:
         "detectable": clip.detectable,
         "error": err,
         "reason": res.get("reason") if res else None,
+        "view": res.get("view") if res else None,  # None for a .npz: no pixels to check
         "snr_block": out.get("snr_block"),
         "windows": res.get("windows_n") if res else None,
         "warnings": out.get("warnings", []),

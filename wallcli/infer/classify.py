@@ -144,6 +144,23 @@ class WindowClassifier:
         return _result(model, times, np.stack(probs), np.asarray(signal), stride=self.stride, source=str(source))
 
 
+def judge_view(rec: dict[str, Any], view: dict) -> dict[str, Any]:
+    """``rec`` (a window or clip answer) with ``view``: where the view is not a static wall, the
+    answer cannot be relied upon whatever the model says, and the view's reason replaces the model's."""
+    rec["view"] = view
+    if not view["usable"]:
+        rec["confident"], rec["reason"] = False, view["reason"]
+    return rec
+
+
+def with_view(result: dict[str, Any], check) -> dict[str, Any]:
+    """``result`` with the verdict of the view check (:class:`wallcli.signal.view.ViewCheck`, fed
+    the same decode) on each window and on the clip."""
+    for w in result.get("windows", []):
+        judge_view(w, check.view(w["start"], w["end"]))
+    return judge_view(result, check.summary())
+
+
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
                    keep_plot: bool = False, taps=()):
     """(result, plot) for a video, decoded once into windows classified as they complete.
@@ -153,20 +170,23 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     ``--plot``) is None unless ``keep_plot``; then it is a :class:`PlotThumbnail` copy of at most
     2048 time columns, enough to draw, not the full plot. ``taps`` (callables) also get every
     decoded frame (:class:`wallcli.io.video.FrameTee`), e.g. to measure the SNR in the same decode.
+    The view check rides on the same decode; its verdict is in the result (:func:`with_view`).
     """
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
+    from wallcli.signal.view import ViewCheck
 
     classifier = WindowClassifier(model, stride)
     thumb = PlotThumbnail() if keep_plot else None
+    check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(FrameTee(reader, taps) if taps else reader, roi=roi, bins=model.bins, fps=model.fps,
+        rows = RowStream(FrameTee(reader, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
                          progress=progress, vertical=keep_plot or "vertical" in model.input_names)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
             classifier.push(t, row, rows.ref)
-    result = classifier.result(str(source))
+    result = with_view(classifier.result(str(source)), check)
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
@@ -211,15 +231,18 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> It
     Rows are raw (not clip-mean-removed): ``normalize_window`` removes each window's own
     mean, so no clip mean, which a live stream does not have, is needed.
     """
-    from wallcli.io.video import open_video
+    from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import RowStream
+    from wallcli.signal.view import ViewCheck
 
     windower = StreamWindower(model.window, stride)
+    check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(reader, roi=roi, bins=model.bins, fps=model.fps, vertical="vertical" in model.input_names)
+        rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps, vertical="vertical" in model.input_names)
         for t, row in rows:
             done = windower.push(t, row)
             if done is not None:
-                yield _window_record(model, done[0], *_predict_window(model, done[2], rows.ref))
+                rec = _window_record(model, done[0], *_predict_window(model, done[2], rows.ref))
+                yield judge_view(rec, check.view(rec["start"], rec["end"]))
     if windower.count < model.window:
         raise _too_short(str(source), windower.count, model)

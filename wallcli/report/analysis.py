@@ -37,6 +37,7 @@ class ClipAnalysis:
     results: dict[str, dict] = field(default_factory=dict)  # task -> docs/contract.md result
     failures: dict[str, str] = field(default_factory=dict)  # task -> why it has no verdict
     warnings: list[str] = field(default_factory=list)
+    view: dict[str, Any] = field(default_factory=dict)  # the view check's verdict on the clip
 
 
 class _Tee:
@@ -50,6 +51,9 @@ class _Tee:
         self._reader, self._requested = reader, roi
         self.info = reader.info
         self.snr = self.grid = self.first = None
+        from wallcli.signal.view import ViewCheck
+
+        self.view = ViewCheck(roi)
 
     @property
     def warnings(self) -> list[str]:
@@ -68,6 +72,7 @@ class _Tee:
                 self.first = planes.rgb()
             self.snr.update(planes)
             self.grid.update(planes)
+            self.view(frame)
             yield frame
 
 
@@ -109,7 +114,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     """Decode ``source`` once and measure, plot and classify it (see the module's docstring)."""
     import warnings
 
-    from wallcli.infer.classify import classify_plot
+    from wallcli.infer.classify import classify_plot, with_view
     from wallcli.io.video import open_video
     from wallcli.signal.stplot import compute_stplot
 
@@ -148,11 +153,12 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         "generated": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     out = ClipAnalysis(str(source), identity, tuple(plot.meta["roi"]), plot, snr, tee.grid, tee.first, models,
-                       warnings=notes)
+                       warnings=notes, view=tee.view.summary())
     for task in TASKS:
         model = models[task]
         try:
-            out.results[task] = classify_plot(model, plot, stride=int(model.card["stride"]), source=str(source))
+            out.results[task] = with_view(classify_plot(model, plot, stride=int(model.card["stride"]), source=str(source)),
+                                          tee.view)
         except WallcliError as exc:  # too short for one window: the rest of the report still stands
             out.failures[task] = str(exc)
     return out

@@ -1,0 +1,142 @@
+"""The view check (issue 27): simulated walls pass, clips that are not a still wall are refused,
+on the same decode as the answers, and an unusable view makes every answer undetermined."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from clips import write_clip
+
+SECONDS = 4.0
+FPS = 30.0
+N = int(SECONDS * FPS)
+
+
+def _scene(seed: int, domain: str, seconds: float = SECONDS, **camera):
+    from wallcli.sim.scene import SceneConfig, sample_scene
+
+    cfg = SceneConfig(people=1, duration=seconds, fps=FPS, width=320, height=240, domain=domain,
+                      codec="libx264", crf=18, nuisance_p=0.5, camera_overrides=camera)
+    return sample_scene(seed, cfg).frames()
+
+
+def _encode(path, frames):
+    from wallcli.io.writer import VideoWriter
+
+    frames = iter(frames)
+    first = next(frames)
+    with VideoWriter(path, FPS, first.shape[1], first.shape[0], codec="libx264", crf=18) as vw:
+        vw.write(first)
+        for f in frames:
+            vw.write(f)
+    return path
+
+
+def _check(path) -> dict:
+    from wallcli.io.video import open_video
+    from wallcli.signal.view import ViewCheck
+
+    vc = ViewCheck()
+    with open_video(path) as reader:
+        for frame in reader.frames():
+            vc(frame)
+    return vc.summary()
+
+
+def _fault(kind: str, seed: int, domain: str, seconds: float = SECONDS):
+    from wallcli.sim import views
+
+    rng = np.random.default_rng(seed)
+    n = int(seconds * FPS)
+    # motion shows only through structure the codec keeps: a wall with visible texture
+    src = _scene(seed, domain, seconds, **({"texture": 0.04} if kind in ("pan", "shake") else {}))
+    if kind == "cut":
+        return views.cut(src, _scene(seed + 1, domain, seconds), rng, n=n)
+    kw = {"sprite": {"contrast": (0.4, 0.6)}, "pan": {"amplitude": 4.0}, "shake": {"rms": 1.5}}[kind]
+    return getattr(views, kind)(src, rng, n=n, fps=FPS, **kw)
+
+
+@pytest.mark.parametrize("domain", ["base", "shifted", "wide", "steady"])
+def test_a_simulated_wall_is_a_usable_view(tmp_path, domain):
+    view = _check(_encode(tmp_path / "w.mp4", _scene(11, domain)))
+    assert view["usable"], view
+    assert view["issues"] == [] and view["reason"] is None
+
+
+@pytest.mark.parametrize("kind, issue", [("sprite", "moving object"), ("pan", "camera motion"),
+                                         ("shake", "camera motion"), ("cut", "scene cut")])
+def test_what_is_not_a_still_wall_is_refused_and_named(tmp_path, kind, issue):
+    view = _check(_encode(tmp_path / "f.mp4", _fault(kind, 21, "base")))
+    assert not view["usable"]
+    assert issue in view["issues"], view
+    assert view["reason"].startswith("not a static view of the wall: ") and " s" in view["reason"]
+
+
+def test_clipped_and_dark_frames_leave_too_little_usable_area(tmp_path):
+    rng = np.random.default_rng(0)
+
+    def clipped(i):  # a lamp or window burning out most of the frame
+        img = np.full((96, 128, 3), 120.0) + rng.normal(0, 2, (96, 128, 3))
+        img[:, 20:] = 255.0
+        return img
+
+    def dark(i):
+        return np.full((96, 128, 3), 3.0) + rng.normal(0, 1, (96, 128, 3))
+
+    a = _check(write_clip(tmp_path / "c.mp4", clipped, 30))
+    assert not a["usable"] and {"clipped", "too little usable area"} <= set(a["issues"])
+    b = _check(write_clip(tmp_path / "d.mp4", dark, 30))
+    assert not b["usable"] and {"too dark", "too little usable area"} <= set(b["issues"])
+
+
+def test_memory_does_not_grow_with_the_number_of_issues():
+    from wallcli.signal.view import MAX_SPANS, ViewCheck
+
+    vc = ViewCheck()
+    vc.frames = 1
+    for i in range(10 * MAX_SPANS):
+        vc._mark("moving object", float(i))  # one span a second, none merging
+    assert len(vc.spans["moving object"]) == MAX_SPANS
+    assert vc.view(5000.0, 5001.0)["issues"] == []
+    assert vc.view(0.0, 1.0)["issues"] == ["moving object"]
+
+
+@pytest.fixture(scope="module")
+def crossing(tmp_path_factory):
+    """10 s of wall with a person crossing the view (one window of count)."""
+    return _encode(tmp_path_factory.mktemp("view") / "crossing.mp4", _fault("sprite", 5, "base", 10.0))
+
+
+def test_count_activity_snr_carry_the_view_and_refuse_a_crossing(run_cli, crossing):
+    code, out, err = run_cli("count", crossing, "--json")
+    assert code == 0, err
+    r = json.loads(out)
+    assert r["view"]["usable"] is False and "moving object" in r["view"]["issues"]
+    assert r["confident"] is False and r["reason"] == r["view"]["reason"]
+    assert all("view" in w for w in r["windows"])
+    assert any(not w["view"]["usable"] and w["confident"] is False for w in r["windows"])
+    code, out, _ = run_cli("snr", crossing, "--json")
+    assert code == 0 and json.loads(out)["view"]["usable"] is False
+    for cmd in (["count"], ["activity"], ["snr", "--json"]):
+        code, out, err = run_cli(*cmd, crossing, "--strict")
+        assert code == 1 and out == ""
+        lines = [x for x in err.splitlines() if x.strip()]
+        assert len(lines) == 1 and lines[0].startswith("Error:") and "moving object" in lines[0], err
+
+
+def test_a_wall_passes_strict(run_cli, tmp_path):
+    clip = _encode(tmp_path / "wall.mp4", _scene(3, "steady", 10.0))
+    code, out, err = run_cli("count", clip, "--json", "--strict")
+    assert code == 0, err
+    r = json.loads(out)
+    assert r["view"]["usable"] is True and all(w["view"]["usable"] for w in r["windows"])
+
+
+def test_scan_puts_the_view_on_the_line(crossing, tmp_path):
+    from wallcli.batch.analyse import analyse
+
+    out = analyse(str(crossing), ("snr",), {})
+    assert out["view"]["usable"] is False
+    assert out["snr"]["view"] == out["view"]
