@@ -106,17 +106,22 @@ def test_static_irradiance_subgrid_matches_exact():
         np.testing.assert_allclose(s.static_irradiance(), exact, rtol=0.01)
 
 
+def _wavers_and_jumpers(domain: str, n: int = 40):
+    """(waving, jumping) pose tracks of n seeded people over 12 s at 30 fps in ``domain``."""
+    t = np.arange(0, 12, 1 / 30)
+    for seed in range(n):
+        rng = np.random.default_rng(seed)
+        yield (motion.make_motion(rng, "waving", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain),
+               motion.make_motion(rng, "jumping", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain))
+
+
 def test_wide_waving_and_jumping_add_whole_arm_motion():
     """The 'wide' domain also waves whole arms from the shoulder and throws arms overhead in
     jumps (larger motions people make); the base domain keeps the seed's forearm wave."""
-    t = np.arange(0, 12, 1 / 30)
     spans = {}
     for domain in ("base", "wide"):
         swings = overhead = 0
-        for seed in range(40):
-            rng = np.random.default_rng(seed)
-            wave = motion.make_motion(rng, "waving", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
-            jump = motion.make_motion(rng, "jumping", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
+        for wave, jump in _wavers_and_jumpers(domain):
             # a whole-arm wave sweeps the arm's elevation by over a radian at the waving rate
             swings += np.ptp(np.diff(wave["arm_abduct"], axis=0)) > 0.05 and not np.any(wave["wave"])
             overhead += jump["arm_abduct"].max() > 1.5
@@ -138,14 +143,10 @@ def test_wide_waves_without_pause_and_jumps_in_rhythm():
     of the transfer set makes such periodic motion; bouts with pauses were all our simulator drew):
     some of its wavers keep the arm up all the time, and some jumpers' height tracks are periodic,
     which never happens in the base domain."""
-    t = np.arange(0, 12, 1 / 30)
     found = {}
     for domain in ("base", "wide"):
         steady_arm = periodic_jump = 0
-        for seed in range(40):
-            rng = np.random.default_rng(seed)
-            wave = motion.make_motion(rng, "waving", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
-            jump = motion.make_motion(rng, "jumping", t, ((1.0, 4.0), (1.5, 3.0)), domain=domain)
+        for wave, jump in _wavers_and_jumpers(domain):
             # arm never lowered back to the side after the first second
             steady_arm += bool(np.all(wave["arm_abduct"][30:].max(axis=1) > 0.3))
             periodic_jump += _periodicity(jump["lift"]) > 0.55

@@ -124,7 +124,7 @@ def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]
     label = classes[k]
     what = label_text(label)
     # 'signal' names the figure: the window's signal_db, not the per-pixel SNR of `wallcli snr`
-    if label in NOBODY and not isinstance(label, bool) and snr_db < NOISE_FLOOR_DB:
+    if label in NOBODY and snr_db < NOISE_FLOOR_DB:
         return False, (f"no movement above the camera's noise (signal {format_db(snr_db)} dB): "
                        "a fainter person would not show")
     if t is None:
