@@ -102,13 +102,22 @@ def _line_sums(plane: np.ndarray, axis: int) -> np.ndarray:
     return plane.sum(axis=axis, dtype=np.uint64).astype(np.float64)
 
 
-def _coverage(origin: int, n: int, edges: np.ndarray) -> np.ndarray:
-    """(bins, n) matrix: the share of each bin [e_b, e_b+1) covered by pixel k = [origin+k, origin+k+1),
-    divided by the bin's width, so that ``matrix @ per_pixel_sums`` gives per-bin means."""
-    lo = origin + np.arange(n, dtype=np.float64)
-    e = np.asarray(edges, np.float64)
-    overlap = np.clip(np.minimum(lo[None, :] + 1, e[1:, None]) - np.maximum(lo[None, :], e[:-1, None]), 0.0, None)
-    return overlap / np.diff(e)[:, None]
+class _Binner:
+    """Per-bin means of per-pixel line sums over (possibly fractional) bin edges: the running sum
+    of box-shaped pixels is exactly piecewise linear, so interpolating it at the edges gives each
+    bin's covered share of every pixel, at the cost of a cumulative sum (a dense coverage matrix
+    product cost 0.1-0.2 ms a 1080p frame, as much as the reductions themselves)."""
+
+    def __init__(self, origin: int, n: int, edges: np.ndarray, across: float):
+        e = np.asarray(edges, np.float64)
+        self.at = e - origin  # edges in the sums' own pixel positions
+        self.grid = np.arange(n + 1, dtype=np.float64)
+        self.scale = 1.0 / (np.diff(e) * float(across))  # bin width x the other side's length
+        self._run = np.zeros(n + 1, np.float64)
+
+    def __call__(self, sums: np.ndarray) -> np.ndarray:
+        np.cumsum(sums, out=self._run[1:])
+        return np.diff(np.interp(self.at, self.grid, self._run)) * self.scale
 
 
 def _fast_sums_fit(sub: np.ndarray) -> bool:
@@ -119,7 +128,7 @@ class ProjectionPlan:
     """Exact means over a rectangle of one plane, binned two ways (see :func:`projection_means`).
 
     The binning matrices depend only on the geometry, so a stream builds the plan once and each
-    frame costs two ``cv2.reduce`` passes and two small matrix-vector products.
+    frame costs two ``cv2.reduce`` passes and two cumulative sums.
     """
 
     def __init__(self, row_edges: np.ndarray, col_edges: np.ndarray):
@@ -127,8 +136,8 @@ class ProjectionPlan:
         self.c0, self.c1 = float(col_edges[0]), float(col_edges[-1])
         self.ri0, self.ri1 = int(np.floor(self.r0)), int(np.ceil(self.r1))
         self.ci0, self.ci1 = int(np.floor(self.c0)), int(np.ceil(self.c1))
-        self.col_bins = _coverage(self.ci0, self.ci1 - self.ci0, col_edges) / (self.r1 - self.r0)
-        self.row_bins = _coverage(self.ri0, self.ri1 - self.ri0, row_edges) / (self.c1 - self.c0)
+        self.col_bins = _Binner(self.ci0, self.ci1 - self.ci0, col_edges, self.r1 - self.r0)
+        self.row_bins = _Binner(self.ri0, self.ri1 - self.ri0, row_edges, self.c1 - self.c0)
         # decided on the first plane: 8-bit and a rectangle of whole pixels (see _fast_call)
         self._fast = None if (self.r0, self.r1, self.c0, self.c1) == (self.ri0, self.ri1, self.ci0, self.ci1) else False
         self._col_sums = np.empty((1, self.ci1 - self.ci0), np.float32)
@@ -136,16 +145,16 @@ class ProjectionPlan:
 
     def _fast_call(self, sub: np.ndarray, rows: bool) -> tuple[np.ndarray, np.ndarray | None]:
         """The common case (8-bit plane, whole-pixel rectangle): OpenCV sums into buffers made
-        once, straight into the binning products; no per-frame arrays but the (bins,) results.
+        once, straight into the binning; no per-frame arrays but the (bins,) results.
         float32 holds these sums exactly (each under 2^24, checked in _fast_sums_fit)."""
         import cv2
 
         cv2.reduce(sub, 0, cv2.REDUCE_SUM, dst=self._col_sums, dtype=cv2.CV_32F)
-        col = self.col_bins @ self._col_sums[0]
+        col = self.col_bins(self._col_sums[0])
         if not rows:
             return col, None
         cv2.reduce(sub, 1, cv2.REDUCE_SUM, dst=self._row_sums, dtype=cv2.CV_32F)
-        return col, self.row_bins @ self._row_sums[:, 0]
+        return col, self.row_bins(self._row_sums[:, 0])
 
     def __call__(self, plane: np.ndarray, rows: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """(column-bin means, row-bin means); ``rows=False`` skips the second reduction (None)."""
@@ -160,14 +169,14 @@ class ProjectionPlan:
         if self.ri1 > self.r1:
             col -= (self.ri1 - self.r1) * sub[-1].astype(np.float64)
         if not rows:
-            return self.col_bins @ col, None
+            return self.col_bins(col), None
         row = _line_sums(sub, 1)
         # Pixels cut by a fractional edge count by the fraction of them inside the rectangle.
         if self.c0 > self.ci0:
             row -= (self.c0 - self.ci0) * sub[:, 0].astype(np.float64)
         if self.ci1 > self.c1:
             row -= (self.ci1 - self.c1) * sub[:, -1].astype(np.float64)
-        return self.col_bins @ col, self.row_bins @ row
+        return self.col_bins(col), self.row_bins(row)
 
 
 def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -179,6 +188,66 @@ def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.nda
     integral image (about 8x faster on 1080p; this is stplot's per-frame cost).
     """
     return ProjectionPlan(row_edges, col_edges)(plane)
+
+
+class _FusedProjection:
+    """Both profiles of every 8-bit plane over whole-pixel rectangles, in one buffer: OpenCV sums
+    each line into its slice, then a single cumulative sum and one interpolation at all the bin
+    edges give every bin mean (the per-plane path spent as long on six small binning steps as
+    on the reductions). Returns (2 or 1, bins, planes) means; exact as :class:`ProjectionPlan`."""
+
+    def __init__(self, rects, rows: bool):
+        import cv2
+
+        self._reduce, self._sum = cv2.reduce, cv2.REDUCE_SUM
+        self.rects = rects  # per plane: (r0, r1, c0, c1, row_edges, col_edges), whole pixels
+        axes = [0, 1] if rows else [0]
+        layout = [(p, axis) for axis in axes for p in range(len(rects))]
+        sizes = [(r[3] - r[2]) if axis == 0 else (r[1] - r[0]) for (p, axis), r in
+                 ((pa, rects[pa[0]]) for pa in layout)]
+        self.buf = np.empty(sum(sizes), np.float32)
+        self._run = np.zeros(self.buf.size + 1, np.float64)
+        self._grid = np.arange(self.buf.size + 1, dtype=np.float64)
+        self.jobs, at, lo, scale = [], [], [], []
+        offset = 0
+        for (p, axis), n in zip(layout, sizes):
+            r0, r1, c0, c1, re, ce = rects[p]
+            view = self.buf[offset:offset + n]
+            self.jobs.append((p, axis, view.reshape((1, n) if axis == 0 else (n, 1))))
+            edges, origin, across = (ce, c0, r1 - r0) if axis == 0 else (re, r0, c1 - c0)
+            lo.extend(len(at) + np.arange(len(edges) - 1))
+            at.extend(np.asarray(edges, np.float64) - origin + offset)
+            scale.extend(1.0 / (np.diff(edges) * across))
+            offset += n
+        self.at = np.asarray(at)
+        self.lo = np.asarray(lo)
+        self.scale = np.asarray(scale)
+        self.shape = (len(axes), len(rects), len(rects[0][5]) - 1)
+
+    def __call__(self, planes) -> np.ndarray:
+        for p, axis, dst in self.jobs:
+            r0, r1, c0, c1 = self.rects[p][:4]
+            self._reduce(planes[p][r0:r1, c0:c1], axis, self._sum, dst=dst, dtype=5)  # 5: CV_32F
+        np.cumsum(self.buf, dtype=np.float64, out=self._run[1:])
+        at = np.interp(self.at, self._grid, self._run)
+        means = (at[self.lo + 1] - at[self.lo]) * self.scale
+        return means.reshape(self.shape).transpose(0, 2, 1)
+
+
+def _fused_rects(planes, rows: np.ndarray, cols: np.ndarray):
+    """The rectangles of :class:`_FusedProjection` when it applies (every plane 8-bit, edges on
+    whole pixels, sums under 2^24 so float32 holds them exactly), else None."""
+    arrays = [planes.y] if planes.u is None else [planes.y, planes.u, planes.v]
+    rects = []
+    for i, a in enumerate(arrays):
+        sy, sx = (0, 0) if i == 0 else (planes.sub_y, planes.sub_x)
+        re, ce = rows / (1 << sy), cols / (1 << sx)
+        r0, r1, c0, c1 = re[0], re[-1], ce[0], ce[-1]
+        if a.dtype != np.uint8 or any(v != int(v) for v in (r0, r1, c0, c1)) \
+                or max(r1 - r0, c1 - c0) * 255 >= (1 << 24):
+            return None
+        rects.append((int(r0), int(r1), int(c0), int(c1), re, ce))
+    return rects
 
 
 class RgbProjector:
@@ -226,7 +295,16 @@ class RgbProjector:
             # reductions themselves (bench/RESULTS.md, issue 28)
             self._m, self._b = planes.rgb_affine()
             self._yuv = np.zeros((2, len(self.cols) - 1, 3))
+            rects = _fused_rects(planes, self.rows, self.cols)
+            self._fused = None if rects is None else _FusedProjection(rects, self.vertical)
         v = self.vertical
+        if self._fused is not None:
+            arrays = (planes.y,) if planes.u is None else (planes.y, planes.u, planes.v)
+            m = self._fused(arrays)
+            if planes.u is None:
+                m = np.repeat(m, 3, axis=2)  # y alone: rgb_affine's chroma rows are then zero
+            rgb = (m @ self._m + self._b).astype(np.float32).astype(np.float64)
+            return rgb[0], (rgb[1] if v else self._zeros)
         yuv = self._yuv
         yuv[0, :, 0], r = self._luma(planes.y, v)
         if v:
