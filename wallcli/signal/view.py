@@ -15,6 +15,7 @@ the sub-pixel shake a tripod on a floor has, which corrections (not refusal) dea
 """
 from __future__ import annotations
 
+import statistics
 from collections import deque
 
 import numpy as np
@@ -29,6 +30,7 @@ K_CUT = 8.0
 REL = 0.05  # of the local level: above any hidden person's shadow
 REL_CUT = 0.02  # one frame to the next: a shadow moves, it does not change a fifth of the wall at once
 CUT_FRACTION = 0.2  # of the usable blocks (simulated walls: at most 1.5 %; cuts between two: 40 % and more)
+CUT_SIDE = 160  # samples along the long side for the cut watch (4x4 per block at 16:9)
 CUT_CALM = 0.1  # the frames before and after a cut (a codec settling after one, a shadow: up to 9 %)
 MIN_MOVER_BLOCKS = 2
 MIN_SHIFT = 1.5  # source pixels from the reference frame
@@ -42,6 +44,12 @@ MIN_USABLE = 0.5  # of the frame's area, neither clipped nor dark
 SIGMA_FLOOR = 0.02  # code values: a frozen (repeated) frame has no measurable noise
 HISTORY = 64  # frames whose noise estimates are pooled (a median: a cut or a mover does not move it)
 MAX_SPANS = 64  # per kind; more are merged, so memory stays bounded
+CHECK_RATE = 5.0  # frames checked per second of a calm view: checking every frame cost more than
+# the analysis itself (3-5 ms a 1080p frame against about 3 for decoding and the plots;
+# bench/RESULTS.md). After a check that finds anything suspect (a shift that fits, a large changed
+# share, a changed block) every frame is checked for DENSE seconds, so the rules that ask for
+# agreement between neighbouring frames (a shake's shifts, a cut's calm sides) see them as before
+DENSE = 0.5
 
 KINDS = {
     "camera motion": "the camera moved",
@@ -54,29 +62,62 @@ KINDS = {
 
 
 def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """A plane (native integer codes) as float32 at ``size`` (w, h), by area averaging. A large
-    plane is first halved, in its own integer type, while it stays at least twice the size
-    (OpenCV's 2x2 area path takes 0.07 ms for 1080p; rounding there adds 0.3 codes of noise to
-    averages whose noise the thresholds measure anyway): converting every full-size pixel to float
-    made the check slower than the decode itself."""
+    """A plane (native integer codes) as float32 at ``size`` (w, h). A large plane is halved by
+    2x2 area averages in its own integer type while it stays at least twice the size (OpenCV's
+    2x2 path takes 0.07 ms for 1080p; rounding there adds 0.3 codes of noise to averages whose
+    noise the thresholds measure anyway), then brought to ``size`` bilinearly: the last factor is
+    under 2, and OpenCV's area resize for such factors took three times the rest together."""
     import cv2
 
-    while a.dtype in (np.uint8, np.uint16) and a.shape[1] >= 4 * size[0] and a.shape[0] >= 4 * size[1]:
+    while a.dtype in (np.uint8, np.uint16) and a.shape[1] >= 2 * size[0] and a.shape[0] >= 2 * size[1]:
         h, w = a.shape
         a = cv2.resize(a[:h - h % 2, :w - w % 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA)
     a = a.astype(np.float32)
-    return a if a.shape[::-1] == tuple(size) else cv2.resize(a, size, interpolation=cv2.INTER_AREA)
+    if a.shape[::-1] == tuple(size):
+        return a
+    fast = a.shape[1] < 2 * size[0] and a.shape[0] < 2 * size[1]
+    return cv2.resize(a, size, interpolation=cv2.INTER_LINEAR if fast else cv2.INTER_AREA)
+
+
+def _crop(a: np.ndarray, roi) -> np.ndarray:
+    if roi is None:
+        return a
+    x, y, w, h = roi
+    c = a[y:y + h, x:x + w]
+    return c if min(c.shape) >= 8 else a  # a bad ROI is the reader's error to give
+
+
+def _sampled_luma(planes, roi, max_side: int) -> np.ndarray:
+    """Luma of the frame (or its ROI) on the 0-255 scale, float32, one pixel in every ``step`` on
+    each axis so that the long side has at most ``max_side`` samples (OpenCV's nearest-neighbour
+    gather: a tenth of the cost of a strided copy, and no area resize of the whole plane)."""
+    import cv2
+
+    y = _crop(planes.y, roi)
+    h, w = y.shape
+    step = max(1, -(-max(h, w) // max_side))
+    size = (max(1, w // step), max(1, h // step))
+
+    def sample(a):
+        a = a if step == 1 else cv2.resize(a[: size[1] * step, : size[0] * step], size, interpolation=cv2.INTER_NEAREST)
+        return a.astype(np.float32)
+
+    scale = np.float32(1 << (planes.depth - 8))
+    y = sample(y)
+    if planes.kind == "rgb":
+        g, b = sample(_crop(planes.u, roi)), sample(_crop(planes.v, roi))
+        return (np.float32(0.299) * y + np.float32(0.587) * g + np.float32(0.114) * b) / scale
+    y /= scale
+    if not planes.full_range:
+        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
+    return y
 
 
 def _grey(planes, roi, max_side: int) -> tuple[np.ndarray, int]:
     """Luma of the frame (or its ROI) as float32 on the 0-255 scale, at most ``max_side`` pixels
     on its long side (what the wall's level is judged on), and the source width it stands for."""
     def crop(a):
-        if roi is None:
-            return a
-        x, y, w, h = roi
-        c = a[y:y + h, x:x + w]
-        return c if min(c.shape) >= 8 else a  # a bad ROI is the reader's error to give
+        return _crop(a, roi)
 
     Y = crop(planes.y)
     h, w = Y.shape
@@ -99,17 +140,58 @@ def _robust_sigma(d: np.ndarray) -> float:
     if d.size == 0:
         return 0.0
     d = np.ravel(d)
-    if d.size > 8192:  # a fixed stride of the image: as good an estimate for a tenth of the sorting
-        d = d[:: d.size // 4096]
+    if d.size > 4096:  # a fixed stride of the image: as good an estimate for a tenth of the sorting
+        d = d[:: d.size // 2048]
     a = np.abs(d - np.median(d))
     keep = a[a <= np.quantile(a, 0.9)]
     return float(np.sqrt(np.mean(keep.astype(np.float64) ** 2) / 0.623 / 2.0)) if keep.size else 0.0
+
+
+def _block_side(shape) -> int:
+    """Pixels per (square) block: BLOCKS blocks along the long side, at least 4 along the short."""
+    return max(1, min(max(shape) // BLOCKS, min(shape) // 4))
+
+
+def _whole_blocks(img: np.ndarray) -> np.ndarray:
+    """The centre of ``img`` that whole blocks tile (a few rows or columns at most are left out):
+    block means then take OpenCV's integer-factor area path, ten times faster than its general one."""
+    side = _block_side(img.shape)
+    h, w = img.shape
+    dh, dw = h % side, w % side
+    return img[dh // 2: h - (dh - dh // 2), dw // 2: w - (dw - dw // 2)]
+
+
+def _upper_median(x: np.ndarray) -> float:
+    k = x.size // 2
+    return float(np.partition(x, k)[k])
+
+
+def _quick_sigma(d: np.ndarray) -> float:
+    """:func:`_robust_sigma` without its interpolated quantiles, for a per-frame budget of a few
+    microseconds (partitions of a few hundred block differences)."""
+    a = np.abs(d - _upper_median(d))
+    k = int(0.9 * (a.size - 1))
+    keep = np.partition(a, k)[:k + 1]
+    return float(np.sqrt(np.mean(keep * keep, dtype=np.float64) / 0.623 / 2.0))
 
 
 def _highpass(img: np.ndarray, sigma: float = 4.0) -> np.ndarray:
     import cv2
 
     return img - cv2.GaussianBlur(img, (0, 0), sigma)
+
+
+def _broad_blur(img: np.ndarray, sigma: float) -> np.ndarray:
+    """A Gaussian blur of large ``sigma`` computed at a quarter of the size (what it keeps has no
+    detail finer than that) and brought back bilinearly: a tenth of the cost of the full kernel."""
+    import cv2
+
+    h, w = img.shape
+    if sigma < 6.0 or min(h, w) < 32:
+        return cv2.GaussianBlur(img, (0, 0), sigma)
+    small = cv2.resize(img, (max(1, w // 4), max(1, h // 4)), interpolation=cv2.INTER_AREA)
+    small = cv2.GaussianBlur(small, (0, 0), np.sqrt(max(sigma ** 2 - 4.0, 1.0)) / 4.0)
+    return cv2.resize(small, (w, h), interpolation=cv2.INTER_LINEAR)
 
 
 class ViewCheck:
@@ -129,9 +211,14 @@ class ViewCheck:
         self._sig_h: deque = deque(maxlen=HISTORY)
         self._prev_b = self._prev_h = self._ref_h = self._bg_h = self._bg_b = None
         self._t_prev = None
+        self._t_checked = -np.inf
+        self._dense_until = -np.inf
         self._scale = 1.0
         self._window = None
         self._fracs = (1.0, 1.0)  # changed shares of the last two frames (none calm before the first)
+        self._cut_prev = self._cut_t = None
+        self._cut_sig: deque = deque(maxlen=HISTORY)
+        self._cut_reset = False
         self._shifts: deque = deque(maxlen=HOLD_WITHIN)  # recent significant shifts (inf: none)
 
     def __call__(self, frame) -> None:
@@ -139,15 +226,71 @@ class ViewCheck:
 
     # ------------------------------------------------------------------ per frame
     def update(self, t: float, planes) -> None:
+        """Watch the frame at time ``t`` for a cut, and check it in full unless one was checked
+        less than 1/CHECK_RATE s before (and nothing suspect was seen since)."""
+        import cv2
+
+        # one OpenCV thread: these images are too small for its pool's hand-offs to pay, and the
+        # decoder keeps the cores busy (as in signal.blocks.RgbProjector)
+        threads = cv2.getNumThreads()
+        cv2.setNumThreads(1)
+        try:
+            cut = self._watch_cut(t, planes)
+            if cut is not None:
+                self._mark("scene cut", cut)
+                self._cut_reset = True
+            if t - self._t_checked < 1.0 / CHECK_RATE - 1e-3 and t > self._dense_until and not self._cut_reset:
+                return
+            self._t_checked = t
+            self._update(t, planes)
+        finally:
+            cv2.setNumThreads(threads)
+
+    def _watch_cut(self, t: float, planes) -> float | None:
+        """The time of the previous frame if it was a cut: much of the frame changed from the frame
+        before it, beyond a whole-frame gain (exposure, flicker), with calm frames on either side
+        (a hard shadow sweeping the wall changes as much, but over several frames). Judged on every
+        frame, one frame late, on block means of the luma sampled on a grid of at most MAX_SIDE
+        on the long side (a cut changes whole blocks; sampling costs a strided copy, not a resize)."""
+        import cv2
+
+        y = _whole_blocks(_sampled_luma(planes, self.roi, CUT_SIDE))
+        bh, bw = (n // _block_side(y.shape) for n in y.shape)
+        blocks = cv2.resize(y, (bw, bh), interpolation=cv2.INTER_AREA)
+        prev, t_prev = self._cut_prev, self._cut_t
+        self._cut_prev, self._cut_t = blocks, t
+        if prev is None or prev.shape != blocks.shape:
+            return None
+        # every step on a few hundred blocks: each numpy call's overhead, not its work, is the cost
+        ok = (np.minimum(blocks, prev) >= DARK) & (np.maximum(blocks, prev) < CLIP_HI)
+        b, p = blocks[ok], prev[ok]
+        if b.size == 0:
+            return None
+        self._cut_sig.append(_quick_sigma(b - p))
+        sigma = max(statistics.median(self._cut_sig), SIGMA_FLOOR)
+        gain = _upper_median(b / p)  # p >= DARK > 0
+        threshold = np.maximum(b * REL_CUT, K_CUT * sigma * np.sqrt(2.0))
+        frac = np.count_nonzero(np.abs(b - gain * p) > threshold) / b.size
+        before = self._fracs
+        self._fracs = (before[1], frac)
+        if frac >= CUT_CALM:
+            self._dense_until = t + DENSE
+        if before[1] > CUT_FRACTION and before[0] < CUT_CALM and frac < CUT_CALM:
+            return t_prev
+        return None
+
+    def _update(self, t: float, planes) -> None:
         import cv2
 
         small, w = _grey(planes, self.roi, MAX_SIDE)
-        h = small.shape[0] * w / small.shape[1]
         self._scale = 1.0 / (small.shape[1] / w)
-        bw = BLOCKS if w >= h else max(4, round(BLOCKS * w / h))
-        bh = max(4, round(bw * h / w))
+        small = _whole_blocks(small)
+        bh, bw = (n // _block_side(small.shape) for n in small.shape)
         blocks = cv2.resize(small, (bw, bh), interpolation=cv2.INTER_AREA)
-        clipped = cv2.resize((small >= CLIP_HI).astype(np.float32), (bw, bh), interpolation=cv2.INTER_AREA) > 0.01
+        if float(small.max()) >= CLIP_HI:
+            clipped = cv2.resize((small >= CLIP_HI).astype(np.float32), (bw, bh), interpolation=cv2.INTER_AREA) > 0.01
+        else:
+            clipped = np.zeros(blocks.shape, bool)
         dark = (blocks < DARK) & ~clipped
         ok = ~(clipped | dark)
         usable = float(ok.mean())
@@ -160,9 +303,10 @@ class ViewCheck:
             if dark.mean() >= (1 - MIN_USABLE) / 2:
                 flags.add("too dark")
         # registration reads a band: finer is mostly noise and codec residue, coarser is light
-        hp = cv2.GaussianBlur(small, (0, 0), 1.5) - cv2.GaussianBlur(small, (0, 0), 8.0)
-        if self._prev_b is None:
+        hp = cv2.GaussianBlur(small, (0, 0), 1.5) - _broad_blur(small, 8.0)
+        if self._prev_b is None or self._cut_reset:
             self._reset(hp, small, blocks)
+            self._cut_reset = False
         else:
             flags |= self._changes(t, blocks, hp, ok, small)
         self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
@@ -179,6 +323,7 @@ class ViewCheck:
         flags = set()
         if not ok.any():
             return flags
+        suspect = False
         prev = self._prev_b
         d = blocks - prev
         self._sig_b.append(_robust_sigma(d[ok]))
@@ -186,18 +331,6 @@ class ViewCheck:
         sigma = max(float(np.median(self._sig_b)), SIGMA_FLOOR)
         var_h = max(float(np.median(self._sig_h)), SIGMA_FLOOR ** 2)
         level = np.maximum(blocks, DARK)
-        # a cut: much of the frame changes from one frame to the next, beyond a whole-frame gain
-        # (exposure, flicker), with calm frames on either side (a hard shadow sweeping the wall
-        # changes as much, but over several frames); judged one frame late, on the previous one
-        gain = float(np.median(blocks[ok] / np.maximum(prev[ok], 1e-3)))
-        jump = np.abs(blocks - gain * prev) > np.maximum(K_CUT * sigma * np.sqrt(2.0), REL_CUT * level)
-        frac = float(jump[ok].mean())
-        before = self._fracs
-        self._fracs = (before[1], frac)
-        if before[1] > CUT_FRACTION and before[0] < CUT_CALM and frac < CUT_CALM:
-            self._mark("scene cut", self._t_prev)
-            self._reset(hp, small, blocks)
-            return flags
         # camera motion: a shift of the frame's fine structure against the reference frame that
         # explains more of the change than the noise could
         if self._window is None or self._window.shape != hp.shape:
@@ -227,6 +360,7 @@ class ViewCheck:
                 near = [1 for x, y in self._shifts if np.hypot(dx - x, dy - y) * self._scale < 1.0]
                 moved = len(near) + 1 >= HOLD
             self._shifts.append((dx, dy) if fits else (np.inf, np.inf))
+            suspect |= fits
         else:
             self._shifts.append((np.inf, np.inf))
         if moved:
@@ -247,6 +381,8 @@ class ViewCheck:
         hit = broad & (np.sqrt(energy) > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & ok
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
+        if suspect or moved or hit.any():
+            self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
         return flags
