@@ -23,9 +23,11 @@ class RowStream:
     """
 
     def __init__(self, reader, *, roi=None, bins: int = 64, fps: float = 30.0,
-                 progress: Callable[[int], None] | None = None, vertical: bool = True):
+                 progress: Callable[[int], None] | None = None, vertical: bool = True, stabilize: bool = False):
         self.reader, self.requested, self.bins, self.fps, self.progress = reader, roi, int(bins), fps, progress
         self.vertical = vertical
+        self.stabilize = stabilize
+        self.shifts = None  # what stabilisation found, once frames are read (a ShiftLog)
         self.roi = None
         self.frame_size = None
         self.ref = None  # the first frame's raw row, subtracted from every row
@@ -43,7 +45,8 @@ class RowStream:
                 # streams), as in compute_stplot
                 self.frame_size = [frame.planes.width, frame.planes.height]
                 self.roi = check_roi(self.requested, *self.frame_size)
-                reduce = RowReducer(self.roi, self.bins, self.vertical)
+                reduce = RowReducer(self.roi, self.bins, self.vertical, self.stabilize)
+                self.shifts = reduce.shifts
             row = np.concatenate(reduce(frame.planes))
             if self.ref is None:
                 self.ref = row

@@ -190,13 +190,67 @@ def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.nda
     return ProjectionPlan(row_edges, col_edges)(plane)
 
 
+class LineShift:
+    """How far the picture moved along one axis since the first frame, from its line sums: a
+    column-sum profile moves with the picture, so correlating the profile's fine structure (a
+    31-pixel moving average removed: light changes, people's shadows and shading are smoother
+    than that) with the first frame's gives the shift, to a few hundredths of a pixel by a
+    parabola through the peak (two FFTs of one line, against a 2-D registration of frames).
+
+    A shift is reported only where the fine structure matches the first frame's with a
+    correlation of at least MATCH: a wall without features (a door frame, a switch, a corner)
+    keeps its random texture under the noise once a column sums it, gives no shift, and is also
+    the wall whose profiles a shake changes least. Searched within MAX pixels: larger motion is
+    the view check's to refuse."""
+
+    MAX = 8
+    MATCH = 0.8
+    SMOOTH = 31
+    MIN = 0.1  # pixels: under it a shift moves a bin's mean by a hundredth of an edge's step at most
+
+    def __init__(self) -> None:
+        self._ref = None
+        self._window = None
+
+    def _fine(self, sums: np.ndarray) -> np.ndarray:
+        import cv2
+
+        line = np.asarray(sums, np.float32).reshape(1, -1)
+        fine = line - cv2.blur(line, (self.SMOOTH, 1), borderType=cv2.BORDER_REFLECT)
+        if self._window is None or self._window.size != fine.size:
+            self._window = np.hanning(fine.size).astype(np.float32)
+        return (fine[0] * self._window).astype(np.float64)
+
+    def __call__(self, sums: np.ndarray) -> float:
+        if len(sums) < 4 * self.SMOOTH:
+            return 0.0
+        fine = self._fine(sums)
+        spec = np.fft.rfft(fine)
+        energy = float(fine @ fine)
+        if self._ref is None or self._ref[0].size != spec.size:
+            self._ref = (np.conj(spec), energy)
+            return 0.0
+        ref, ref_energy = self._ref
+        c = np.fft.irfft(spec * ref, len(sums)) / max(np.sqrt(energy * ref_energy), 1e-30)
+        m = self.MAX
+        near = np.concatenate([c[-m:], c[:m + 1]])  # lags -m..m
+        k = int(np.argmax(near))
+        if not 0 < k < 2 * m or near[k] < self.MATCH:
+            return 0.0
+        a, b, d = near[k - 1], near[k], near[k + 1]
+        den = a - 2 * b + d
+        frac = 0.5 * (a - d) / den if den < 0 else 0.0
+        shift = float(k - m + np.clip(frac, -0.5, 0.5))
+        return shift if abs(shift) >= self.MIN else 0.0
+
+
 class _FusedProjection:
     """Both profiles of every 8-bit plane over whole-pixel rectangles, in one buffer: OpenCV sums
     each line into its slice, then a single cumulative sum and one interpolation at all the bin
     edges give every bin mean (the per-plane path spent as long on six small binning steps as
     on the reductions). Returns (2 or 1, bins, planes) means; exact as :class:`ProjectionPlan`."""
 
-    def __init__(self, rects, rows: bool):
+    def __init__(self, rects, rows: bool, stabilize: bool = False, sub=(0, 0)):
         import cv2
 
         self._reduce, self._sum = cv2.reduce, cv2.REDUCE_SUM
@@ -208,20 +262,36 @@ class _FusedProjection:
         self.buf = np.empty(sum(sizes), np.float32)
         self._run = np.zeros(self.buf.size + 1, np.float64)
         self._grid = np.arange(self.buf.size + 1, dtype=np.float64)
-        self.jobs, at, lo, scale = [], [], [], []
+        self.jobs, at, lo, scale, per_px, bounds, acr = [], [], [], [], [], [], []
         offset = 0
+        self.lines = {}  # (plane, axis) -> that line-sum vector in the buffer (a view)
         for (p, axis), n in zip(layout, sizes):
             r0, r1, c0, c1, re, ce = rects[p]
             view = self.buf[offset:offset + n]
+            self.lines[(p, axis)] = view
             self.jobs.append((p, axis, view.reshape((1, n) if axis == 0 else (n, 1))))
             edges, origin, across = (ce, c0, r1 - r0) if axis == 0 else (re, r0, c1 - c0)
             lo.extend(len(at) + np.arange(len(edges) - 1))
             at.extend(np.asarray(edges, np.float64) - origin + offset)
             scale.extend(1.0 / (np.diff(edges) * across))
+            acr.extend([across] * (len(edges) - 1))
+            # a luma shift in this plane's pixels (chroma is subsampled), along this axis
+            sx, sy = (0, 0) if p == 0 else sub
+            unit = np.zeros(2)
+            unit[axis] = 1.0 / (1 << (sx if axis == 0 else sy))
+            per_px.extend([unit] * len(edges))
+            bounds.extend([(offset, offset + n)] * len(edges))
             offset += n
         self.at = np.asarray(at)
         self.lo = np.asarray(lo)
         self.scale = np.asarray(scale)
+        self._across = np.asarray(acr, np.float64)
+        self._per_px = np.asarray(per_px)  # (edges, 2): how far each edge moves per (dx, dy) pixel
+        self._bounds = np.asarray(bounds, np.float64)
+        self.stabilize = bool(stabilize)
+        self._shift_x = LineShift() if stabilize else None
+        self._shift_y = LineShift() if stabilize and rows else None
+        self.shift = (0.0, 0.0)  # the last frame's (dx, dy) in luma pixels, applied before binning
         self.shape = (len(axes), len(rects), len(rects[0][5]) - 1)
 
     def __call__(self, planes) -> np.ndarray:
@@ -229,8 +299,24 @@ class _FusedProjection:
             r0, r1, c0, c1 = self.rects[p][:4]
             self._reduce(planes[p][r0:r1, c0:c1], axis, self._sum, dst=dst, dtype=5)  # 5: CV_32F
         np.cumsum(self.buf, dtype=np.float64, out=self._run[1:])
+        if self.stabilize:
+            dx = self._shift_x(self.lines[(0, 0)])
+            dy = self._shift_y(self.lines[(0, 1)]) if self._shift_y is not None else 0.0
+            self.shift = (dx, dy)
+            if dx or dy:
+                return self._shifted(dx, dy)
         at = np.interp(self.at, self._grid, self._run)
         means = (at[self.lo + 1] - at[self.lo]) * self.scale
+        return means.reshape(self.shape).transpose(0, 2, 1)
+
+    def _shifted(self, dx: float, dy: float) -> np.ndarray:
+        """Bin means of the picture as it was in the first frame: each edge read where the picture
+        moved it (the running sum of box pixels is exact at fractional positions); a bin that the
+        motion pushed past the frame's edge is averaged over the part still in view."""
+        pos = np.clip(self.at + self._per_px @ np.array([dx, dy]), self._bounds[:, 0], self._bounds[:, 1])
+        at = np.interp(pos, self._grid, self._run)
+        width = (pos[self.lo + 1] - pos[self.lo]) * self._across
+        means = (at[self.lo + 1] - at[self.lo]) / np.maximum(width, 1e-9)
         return means.reshape(self.shape).transpose(0, 2, 1)
 
 
@@ -250,6 +336,31 @@ def _fused_rects(planes, rows: np.ndarray, cols: np.ndarray):
     return rects
 
 
+class ShiftLog:
+    """What stabilisation found over a stream, in memory that does not grow: frames moved (by at
+    least LineShift.MIN), and the RMS and largest of their shifts (luma pixels)."""
+
+    def __init__(self) -> None:
+        self.frames = self.moved = 0
+        self._sq = 0.0
+        self.largest = 0.0
+
+    def add(self, dx: float, dy: float) -> None:
+        self.frames += 1
+        r2 = dx * dx + dy * dy
+        if r2:
+            self.moved += 1
+            self._sq += r2
+            self.largest = max(self.largest, float(np.sqrt(r2)))
+
+    def summary(self) -> dict | None:
+        """The ``corrections`` entry, or None when no frame was moved."""
+        if not self.moved:
+            return None
+        return {"kind": "shake", "frames": self.moved, "of": self.frames,
+                "rms_px": round(float(np.sqrt(self._sq / self.moved)), 3), "max_px": round(self.largest, 3)}
+
+
 class RgbProjector:
     """Per frame: the horizontal and vertical RGB profiles (bins, 3) of ``roi``, float64, 0-255.
 
@@ -258,11 +369,13 @@ class RgbProjector:
     horizontal plot (count) saves half of the per-frame reductions.
     """
 
-    def __init__(self, roi: Roi, bins: int, vertical: bool = True):
+    def __init__(self, roi: Roi, bins: int, vertical: bool = True, stabilize: bool = False):
         import cv2
 
         self._cv2 = cv2
         self.vertical = bool(vertical)
+        self.stabilize = bool(stabilize)
+        self.shifts = ShiftLog()
         self._zeros = np.zeros((int(bins), 3))
         x, y, w, h = roi
         self.rows = bin_edges(y, y + h, bins)
@@ -296,11 +409,14 @@ class RgbProjector:
             self._m, self._b = planes.rgb_affine()
             self._yuv = np.zeros((2, len(self.cols) - 1, 3))
             rects = _fused_rects(planes, self.rows, self.cols)
-            self._fused = None if rects is None else _FusedProjection(rects, self.vertical)
+            self._fused = None if rects is None else _FusedProjection(
+                rects, self.vertical, self.stabilize, (planes.sub_x, planes.sub_y))
         v = self.vertical
         if self._fused is not None:
             arrays = (planes.y,) if planes.u is None else (planes.y, planes.u, planes.v)
             m = self._fused(arrays)
+            if self.stabilize:
+                self.shifts.add(*self._fused.shift)
             if planes.u is None:
                 m = np.repeat(m, 3, axis=2)  # y alone: rgb_affine's chroma rows are then zero
             rgb = (m @ self._m + self._b).astype(np.float32).astype(np.float64)

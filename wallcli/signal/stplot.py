@@ -45,9 +45,14 @@ class StPlot:
 class RowReducer:
     """Per frame: the raw (not mean-removed) horizontal and vertical rows, float64 (bins, 3)."""
 
-    def __init__(self, roi: Roi, bins: int = 64, vertical: bool = True):
+    def __init__(self, roi: Roi, bins: int = 64, vertical: bool = True, stabilize: bool = False):
         self.roi, self.bins = roi, int(bins)
-        self._project = RgbProjector(roi, self.bins, vertical)
+        self._project = RgbProjector(roi, self.bins, vertical, stabilize)
+
+    @property
+    def shifts(self):
+        """What stabilisation found (:class:`wallcli.signal.blocks.ShiftLog`)."""
+        return self._project.shifts
 
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
         return self._project(planes)

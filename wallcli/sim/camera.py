@@ -47,6 +47,9 @@ class CameraParams:
     ae_steps: int = 0
     ae_size: float = 0.02
     shake: float = 0.0  # rms sub-pixel shake (pixels)
+    shake_exact: bool = False  # shake as an exact warp of each frame, not the first-order shift
+    features: float = 0.0  # relative contrast of a door frame, a switch plate and a skirting
+    # board on the wall (0: a plain wall): the structure a shaking camera's profiles move with
     noise_scale: float = 1.0  # user multiplier on all temporal noise
 
     def to_dict(self) -> dict:
@@ -141,6 +144,28 @@ def _smooth_noise(rng, n: int, scale: float) -> np.ndarray:
     return scale * f / 4
 
 
+def _features(H: int, W: int, contrast: float) -> np.ndarray:
+    """A reflectance map with a door frame (a vertical band), a switch plate and a skirting board
+    (a horizontal band), each ``contrast`` darker than the wall, edges a pixel soft."""
+    import cv2
+
+    m = np.ones((H, W), np.float32)
+    m[:, int(0.70 * W):int(0.74 * W)] -= contrast
+    m[int(0.45 * H):int(0.55 * H), int(0.20 * W):int(0.25 * W)] -= contrast
+    m[int(0.92 * H):int(0.95 * H), :] -= contrast
+    return cv2.GaussianBlur(np.clip(m, 0.05, 1.0), (0, 0), 0.7)
+
+
+def _warp_chw(img: np.ndarray, dx: float, dy: float) -> np.ndarray:
+    """An (H, 3, W) image moved by (dx, dy) pixels, bicubic, edges reflected."""
+    import cv2
+
+    hwc = np.ascontiguousarray(img.transpose(0, 2, 1))
+    m = np.float32([[1, 0, dx], [0, 1, dy]])
+    out = cv2.warpAffine(hwc, m, (hwc.shape[1], hwc.shape[0]), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
+    return np.ascontiguousarray(out.transpose(0, 2, 1))
+
+
 class Camera:
     """Turns irradiance grids into frames; all static maps and nuisance tracks fixed at init."""
 
@@ -159,6 +184,8 @@ class Camera:
         low = wall_albedo * (1 + _smooth_noise(rng, max(H, W), 0.06)[:H, :W, None])
         prnu = 1 + p.prnu * rng.standard_normal((H, W, 3))
         self.gain_map = low * np.clip(fine, 0.5, 1.5) * (1 - p.vignette * r2)[..., None] * prnu
+        if p.features:
+            self.gain_map = self.gain_map * _features(H, W, p.features)[..., None]
         img = self.gain_map * self.upsample(static_E).transpose(0, 2, 1)
         lin_level = 255.0 * (p.level / 255.0) ** p.gamma if p.gamma else p.level
         self.k = lin_level / img.mean()
@@ -231,7 +258,9 @@ class Camera:
         if static_E is not None:
             lin += self.static
         dx, dy = self.shifts[index]
-        if dx or dy:
+        if (dx or dy) and self.p.shake_exact:
+            lin = _warp_chw(lin, dx, dy)
+        elif dx or dy:
             lin += np.float32(dx) * self.grad_x + np.float32(dy) * self.grad_y
         noise = self.rng.standard_normal(lin.shape, dtype=np.float32)
         noise *= self.sigma
