@@ -206,7 +206,7 @@ class LineShift:
     MAX = 8
     MATCH = 0.8
     SMOOTH = 31
-    MIN = 0.1  # pixels: under it a shift moves a bin's mean by a hundredth of an edge's step at most
+    MIN = 0.0  # pixels: any shift found is applied (a deadband left edge bins jumping by codes)
 
     def __init__(self) -> None:
         self._ref = None

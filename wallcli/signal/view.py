@@ -46,9 +46,10 @@ HISTORY = 64  # frames whose noise estimates are pooled (a median: a cut or a mo
 MAX_SPANS = 64  # per kind; more are merged, so memory stays bounded
 CHECK_RATE = 5.0  # frames checked per second of a calm view: checking every frame cost more than
 # the analysis itself (3-5 ms a 1080p frame against about 3 for decoding and the plots;
-# bench/RESULTS.md). After a check that finds anything suspect (a shift that fits, a large changed
-# share, a changed block) every frame is checked for DENSE seconds, so the rules that ask for
-# agreement between neighbouring frames (a shake's shifts, a cut's calm sides) see them as before
+# bench/RESULTS.md). After a check that finds anything suspect (a shift that fits, a block far off
+# its background; or a frame of the cut watch with a large changed share) every frame is checked
+# for DENSE seconds, so the rules that ask for agreement between neighbouring frames (a shake's
+# shifts) and a mover's outline get every frame's chance, as before
 DENSE = 0.5
 
 KINDS = {
@@ -381,7 +382,7 @@ class ViewCheck:
         hit = broad & (np.sqrt(energy) > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & ok
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
-        if suspect or moved or hit.any():
+        if suspect or moved or (broad & ok).any():
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
