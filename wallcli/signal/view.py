@@ -44,7 +44,7 @@ MIN_USABLE = 0.5  # of the frame's area, neither clipped nor dark
 SIGMA_FLOOR = 0.02  # code values: a frozen (repeated) frame has no measurable noise
 HISTORY = 64  # frames whose noise estimates are pooled (a median: a cut or a mover does not move it)
 MAX_SPANS = 64  # per kind; more are merged, so memory stays bounded
-CHECK_RATE = 5.0  # frames checked per second of a calm view: checking every frame cost more than
+CHECK_RATE = 3.0  # frames checked per second of a calm view: checking every frame cost more than
 # the analysis itself (3-5 ms a 1080p frame against about 3 for decoding and the plots;
 # bench/RESULTS.md). After a check that finds anything suspect (a shift that fits, a block far off
 # its background; or a frame of the cut watch with a large changed share) every frame is checked
@@ -340,7 +340,9 @@ class ViewCheck:
         (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
         shift = float(np.hypot(dx, dy)) * self._scale
         moved = False
-        if shift >= MIN_SHIFT and min(hp.shape) > 32:  # smaller: no structure to register on
+        # a shift of half the floor that fits is not motion yet, but a shake on its way to it:
+        # every frame is then checked (see CHECK_RATE), as the old every-frame check did
+        if shift >= MIN_SHIFT / 2 and min(hp.shape) > 32:  # smaller: no structure to register on
             # the reference moved by +s must fit far better than moved by -s: both warps smooth
             # its noise alike, so only a real shift of shared structure separates them; the
             # spread of the difference of two means of N squared residuals is e*sqrt(8/N), N
@@ -357,11 +359,12 @@ class ViewCheck:
             fits = (e[1] - e[0]) > K_SHIFT * max(e[0], var_h) * np.sqrt(8.0 / n)
             # and it must hold from one frame to the next: a camera moves smoothly, while the
             # correlation peaks of noise land anywhere
+            suspect |= fits
+            fits &= shift >= MIN_SHIFT
             if fits:
                 near = [1 for x, y in self._shifts if np.hypot(dx - x, dy - y) * self._scale < 1.0]
                 moved = len(near) + 1 >= HOLD
             self._shifts.append((dx, dy) if fits else (np.inf, np.inf))
-            suspect |= fits
         else:
             self._shifts.append((np.inf, np.inf))
         if moved:
