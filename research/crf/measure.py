@@ -275,12 +275,15 @@ def limit(rows, scenes, lossless) -> dict:
         if not o["lost"]:
             txt = f"at CRF {crf} count kept every answer it got right lossless ({o['kept']} scenes with people)"
         else:
+            x = o["lost_max_snr"]
+            above = [k for k in kept if k > x]
+            o["kept_above"] = len(above)
             txt = (f"at CRF {crf} count lost {o['lost']} of the {o['lost'] + o['kept']} scenes with people it got right "
-                   f"lossless, of lossless SNR up to {o['lost_max_snr']:.1f} dB"
-                   + (f" (the faintest it kept: {o['kept_min_snr']:.1f} dB)" if o["kept"] else " (it kept none)"))
-        txt += f", and answered '0 people' on {zero} of all {withp} scenes with people"
-        sentences.append(txt)
-    return {"per_crf": out, "sentence": "; ".join(sentences) + "."}
+                   f"lossless, all at a lossless SNR of {x:.1f} dB or under (it kept {o['kept'] - len(above)} there), "
+                   + (f"and kept all {len(above)} above it" if above else "and no scene above it was measured"))
+        txt += f"; it answered '0 people' on {zero} of all {withp} scenes with people"
+        sentences.append("- " + txt[0].upper() + txt[1:] + ".")
+    return {"per_crf": out, "sentence": "\n".join(sentences)}
 
 
 def verify(a) -> None:
