@@ -259,7 +259,7 @@ def limit(rows, scenes, lossless) -> dict:
     scenes with people it answers '0 people' (the signal erased)."""
     out, sentences = {}, []
     for crf in CRFS[1:]:
-        lost, kept, zero, withp = [], [], 0, 0
+        lost, kept, zero, withp, zsnr, seen = [], [], 0, 0, [], []
         for key in scenes:
             z = lossless[key]
             if not z["people"]:
@@ -267,6 +267,7 @@ def limit(rows, scenes, lossless) -> dict:
             r = next(x for x in rows if (x["seed"], x["size"]) == key and x["crf"] == crf)
             withp += 1
             zero += r["count"]["label"] == 0
+            (zsnr if r["count"]["label"] == 0 else seen).append(z["snr_db"])
             if z["count"]["label"] != z["people"]:
                 continue
             (kept if r["count"]["label"] == r["people"] else lost).append(z["snr_db"])
@@ -281,7 +282,12 @@ def limit(rows, scenes, lossless) -> dict:
             txt = (f"at CRF {crf} count lost {o['lost']} of the {o['lost'] + o['kept']} scenes with people it got right "
                    f"lossless, all at a lossless SNR of {x:.1f} dB or under (it kept {o['kept'] - len(above)} there), "
                    + (f"and kept all {len(above)} above it" if above else "and no scene above it was measured"))
-        txt += f"; it answered '0 people' on {zero} of all {withp} scenes with people"
+        o["erased_max_snr"] = max(zsnr) if zsnr else None
+        o["seen_above"] = sum(v > o["erased_max_snr"] for v in seen) if zsnr else len(seen)
+        txt += f"; it answered '0 people' (the person erased) on {zero} of all {withp} scenes with people"
+        if zsnr:
+            txt += (f", none of lossless SNR over {o['erased_max_snr']:.1f} dB ({o['seen_above']} scenes above it, each "
+                    f"answered 1 or 2 people; under it {len(zsnr)} of {len(zsnr) + len(seen) - o['seen_above']} erased)")
         sentences.append("- " + txt[0].upper() + txt[1:] + ".")
     return {"per_crf": out, "sentence": "\n".join(sentences)}
 
