@@ -31,6 +31,9 @@ REL = 0.05  # of the local level: above any hidden person's shadow
 REL_CUT = 0.02  # one frame to the next: a shadow moves, it does not change a fifth of the wall at once
 CUT_FRACTION = 0.2  # of the usable blocks (simulated walls: at most 1.5 %; cuts between two: 40 % and more)
 CUT_SIDE = 160  # samples along the long side for the cut watch (4x4 per block at 16:9)
+CUT_RATE = 15.0  # frames a second the cut watch compares (every other frame at 30 fps): a cut is
+# one jump between any two of them, while a sweeping shadow changes a sample pair 2 frames apart
+# by a third of what 6 frames (a full check's spacing) did on the walls measured
 CUT_CALM = 0.1  # the frames before and after a cut (a codec settling after one, a shadow: up to 9 %)
 MIN_MOVER_BLOCKS = 2
 MIN_SHIFT = 1.5  # source pixels from the reference frame
@@ -214,6 +217,7 @@ class ViewCheck:
         self._t_prev = None
         self._t_checked = -np.inf
         self._dense_until = -np.inf
+        self._gap = np.inf  # the shortest time between two checked frames: one frame interval
         self._scale = 1.0
         self._window = None
         self._fracs = (1.0, 1.0)  # changed shares of the last two frames (none calm before the first)
@@ -236,7 +240,7 @@ class ViewCheck:
         threads = cv2.getNumThreads()
         cv2.setNumThreads(1)
         try:
-            cut = self._watch_cut(t, planes)
+            cut = self._watch_cut(t, planes) if self._cut_t is None or t - self._cut_t >= 1.0 / CUT_RATE - 1e-3 else None
             if cut is not None:
                 self._mark("scene cut", cut)
                 self._cut_reset = True
@@ -316,6 +320,7 @@ class ViewCheck:
             self._mark(kind, t)
 
     def _reset(self, hp, small, blocks) -> None:
+        self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
 
     def _changes(self, t, blocks, hp, ok, small) -> set:
@@ -327,8 +332,14 @@ class ViewCheck:
         suspect = False
         prev = self._prev_b
         d = blocks - prev
-        self._sig_b.append(_robust_sigma(d[ok]))
-        self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2 if min(hp.shape) > 8 else 0.0)
+        # the noise is measured between neighbouring frames only: between checks a fifth of a
+        # second apart a shake or a shadow has moved the picture too, and the thresholds built
+        # on such a 'noise' let exactly those through
+        gap = t - self._t_prev
+        self._gap = min(self._gap, gap)
+        if gap <= 1.5 * self._gap or not self._sig_b:
+            self._sig_b.append(_robust_sigma(d[ok]))
+            self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2 if min(hp.shape) > 8 else 0.0)
         sigma = max(float(np.median(self._sig_b)), SIGMA_FLOOR)
         var_h = max(float(np.median(self._sig_h)), SIGMA_FLOOR ** 2)
         level = np.maximum(blocks, DARK)
