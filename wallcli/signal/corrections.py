@@ -1,0 +1,455 @@
+"""Whole-frame light nuisances found and removed before analysis: aliased mains flicker (whole-frame
+and rolling-shutter bands) and auto-exposure steps and slow drift.
+
+Works on the raw per-frame profiles of the ROI (the space-time plots' rows, or any per-frame
+profile such as the SNR estimator's row means), never on pixels, one stretch of frames at a time
+(a 256-sample window of the classifiers, or a block of the SNR estimator's frames): memory is
+bounded and ``--follow`` still works.
+
+What a nuisance is, and what a person is. A person changes the wall by 0.1-1 % unevenly along
+it and not periodically. The nuisances here are whole-frame and multiplicative, and each has a
+shape a person does not make:
+
+- **flicker**: lamps on mains power flicker at twice the mains frequency (100 or 120 Hz); a
+  camera samples that at its frame rate, so the video carries a *narrow line* at the alias
+  frequency |2 f_mains - k fps| (10 Hz for 50 Hz mains at 30 fps, 5 Hz at 25 fps with 60 Hz
+  mains). Only those predicted frequencies (within ``SEARCH_HZ``) are searched, and a line is
+  removed only when its power summed over the bins stands ``LINE_RATIO`` times above its
+  neighbourhood of the spectrum. Each bin's own sinusoid at that frequency is removed, so the
+  rolling-shutter form (bands whose phase advances down the frame, the vertical bins' phases
+  differing) goes as completely as the whole-frame one; a person loses one frequency bin out of
+  128 at most.
+- **exposure**: the whole frame's gain, robustly (the median over the bins of each bin's
+  relative change, so that a shadow over part of the wall does not move it): steps (jumps of at
+  least ``STEP_MIN`` and ``STEP_SIGMA`` times the gain's frame noise, within ``RAMP_S`` seconds:
+  beyond what a hidden person does to the whole wall in a few frames) and drift (a cubic over
+  the stretch, slower than about one cycle in 8 s; removed only when it exceeds ``DRIFT_MIN``
+  peak to peak).
+
+``correct`` divides the found gains out and returns what was found; ``merge`` sums a clip's
+findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
+``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``).
+A slot for camera shake (``kind: "shake"``) belongs beside these, before the block sums.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+MAINS_HZ = (50.0, 60.0)
+MIN_LINE_HZ = 0.5  # slower aliases are drift's business
+SEARCH_HZ = 0.3  # mains and camera clocks wander: search this far around each predicted alias
+LINE_RATIO = 25.0  # line power over the median of its +-3 Hz neighbourhood
+STEP_MIN = 0.003  # relative size of the smallest exposure step removed
+STEP_SIGMA = 10.0  # and in units of the gain's frame-to-frame noise
+RAMP_S = 0.33  # seconds an exposure step may take
+SPAN_S = 0.5  # seconds averaged on each side of a step
+GROUPS = 8  # the bins are judged alike in this many groups of neighbours (less noise than one by one)
+MAX_STEPS = 4
+DRIFT_DEGREE = 3
+DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
+MIN_SAMPLES = 64  # shorter stretches are left alone
+UNEVEN = 0.25  # a bin's change within this fraction of the common one (plus its noise) is alike
+AGREE = 0.6  # fraction of the bins that must change alike for a step or drift to be the light's
+
+
+@dataclass(frozen=True)
+class Options:
+    deflicker: bool = True
+    exposure: bool = True
+
+    @property
+    def any(self) -> bool:
+        return self.deflicker or self.exposure
+
+
+OFF = Options(False, False)
+
+
+def fold(f: float, rate: float) -> float:
+    """The frequency a sinusoid of ``f`` Hz shows when sampled at ``rate`` Hz (in [0, rate/2])."""
+    x = float(f) % float(rate)
+    return min(x, rate - x)
+
+
+def mains_lines(native_fps: float | None, rate: float) -> list[float]:
+    """Where aliased mains flicker can show in a series at ``rate`` made from video at
+    ``native_fps`` (twice the mains frequency, folded by the camera, then by any resampling)."""
+    fps = float(native_fps) if native_fps and native_fps > 0 else float(rate)
+    out = []
+    for mains in MAINS_HZ:
+        f = fold(fold(2 * mains, fps), rate)
+        if f >= MIN_LINE_HZ and f < rate / 2 - SEARCH_HZ and all(abs(f - g) > 2 * SEARCH_HZ for g in out):
+            out.append(f)
+    return out
+
+
+# ------------------------------------------------------------------------------------ flicker
+def _find_line(rel: np.ndarray, rate: float, lines) -> tuple[float, float] | None:
+    """(frequency, line ratio) of the strongest aliased mains line in ``rel`` (T, K) (relative
+    changes, K series), or None."""
+    t = rel.shape[0]
+    pad = 16 * t
+    win = np.hanning(t)[:, None]
+    spec = np.abs(np.fft.rfft((rel - rel.mean(axis=0)) * win, n=pad, axis=0)) ** 2
+    power = spec.sum(axis=1)
+    freqs = np.fft.rfftfreq(pad, 1.0 / rate)
+    best = None
+    for f0 in lines:
+        near = np.abs(freqs - f0) <= SEARCH_HZ
+        around = (np.abs(freqs - f0) <= 3.0) & ~(np.abs(freqs - f0) <= SEARCH_HZ + 4.0 * rate / t) & (freqs >= MIN_LINE_HZ)
+        if not near.any() or around.sum() < 8:
+            continue
+        i = int(np.flatnonzero(near)[np.argmax(power[near])])
+        ratio = float(power[i] / max(np.median(power[around]), 1e-300))
+        if ratio < LINE_RATIO:
+            continue
+        f = freqs[i]
+        if 0 < i < len(power) - 1:  # parabolic interpolation of the log peak
+            a, b, c = np.log(power[i - 1:i + 2] + 1e-300)
+            den = a - 2 * b + c
+            if den < 0:
+                f += 0.5 * (a - c) / den * (freqs[1] - freqs[0])
+        if best is None or ratio > best[1]:
+            best = (float(f), ratio)
+    return best
+
+
+def _sinusoids(rel: np.ndarray, f: float, rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares (cos, sin) amplitudes of ``f`` in each column of ``rel`` (T, K), fitted with a
+    constant and a slope beside them; returns (basis (T, 2), coefficients (2, K))."""
+    t = np.arange(rel.shape[0]) / rate
+    ph = 2 * np.pi * f * t
+    tt = (t - t.mean()) / max(t.std(), 1e-9)
+    design = np.stack([np.cos(ph), np.sin(ph), np.ones_like(t), tt], axis=1)
+    coef, *_ = np.linalg.lstsq(design, rel, rcond=None)
+    return design[:, :2], coef[:2]
+
+
+# ------------------------------------------------------------------------------------ exposure
+def _robust_gain(rel: np.ndarray) -> np.ndarray:
+    """The whole frame's relative gain per sample: the median over the series of (T, K)."""
+    return np.median(rel, axis=1)
+
+
+def _legendre(t: int, degree: int) -> np.ndarray:
+    x = np.linspace(-1.0, 1.0, t)
+    return np.polynomial.legendre.legvander(x, degree)
+
+
+def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None) -> float:
+    """:func:`_agree_one` for each profile (``part`` (K,) says which bin is whose), the least."""
+    if part is None:
+        return _agree_one(per_bin, common, tol)
+    return min(_agree_one(per_bin[part == p], common, tol[part == p]) for p in np.unique(part))
+
+
+def _agree_one(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray) -> float:
+    """The fraction of bins whose change (per_bin (K, ...)) is the common one (...) within
+    ``UNEVEN`` of it plus their own noise ``tol`` (K,): a change of the light multiplies every
+    bin alike, a person's shadow does not. Bins are pooled in ``GROUPS`` runs of neighbours first,
+    so that noisy bins cannot agree with anything."""
+    k = per_bin.shape[0]
+    g = min(GROUPS, k)
+    edges = (np.arange(g + 1) * k) // g
+    per_bin = np.stack([per_bin[a:b].mean(axis=0) for a, b in zip(edges[:-1], edges[1:])])
+    tol = np.array([np.sqrt(np.mean(np.square(tol[a:b])) / (b - a)) for a, b in zip(edges[:-1], edges[1:])])
+    dev = np.sqrt(np.mean(np.square(per_bin - common[None]).reshape(per_bin.shape[0], -1), axis=1))
+    size = float(np.sqrt(np.mean(np.square(common))))
+    return float(np.mean(dev <= UNEVEN * size + tol))
+
+
+def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
+    """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
+    changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins. Steps
+    are found greedily where the means of the ``SPAN_S`` seconds on either side of a ``RAMP_S``
+    differ by more than STEP_MIN and STEP_SIGMA noise, and kept only where most bins stepped alike
+    (``AGREE``) in every profile (``part`` (K,): which profile each bin is of; a person's shadow
+    can dim all the rows of a wall alike, not also all its columns); so is the drift."""
+    t = rel.shape[0]
+    g = _robust_gain(rel)
+    basis = _legendre(t, DRIFT_DEGREE)
+    dg = np.diff(g)
+    noise = 1.4826 * np.median(np.abs(dg - np.median(dg))) / np.sqrt(2.0)
+    db = np.diff(rel, axis=0)
+    sigma = 1.4826 * np.median(np.abs(db - np.median(db, axis=0)), axis=0) / np.sqrt(2.0)  # (K,) per bin
+    found: list[int] = []
+    blocked: list[int] = []
+    cols = [basis]
+    ramp = max(2, int(round(RAMP_S * rate)))
+    span = max(4, int(round(SPAN_S * rate)))
+    half = ramp // 2
+    c_bins = np.concatenate([np.zeros((1, rel.shape[1])), np.cumsum(rel, axis=0)])
+    for _ in range(2 * MAX_STEPS):
+        if len(found) >= MAX_STEPS:
+            break
+        design = np.concatenate(cols, axis=1)
+        coef, *_ = np.linalg.lstsq(design, g, rcond=None)
+        r = g - design @ coef
+        c = np.concatenate([[0.0], np.cumsum(r)])
+        idx = np.arange(span + half, t - span - half)
+        if idx.size == 0:
+            break
+        after = (c[idx + half + span] - c[idx + half]) / span
+        before = (c[idx - half] - c[idx - half - span]) / span
+        d = after - before
+        for j in found + blocked:  # one step is looked at once
+            d[np.abs(idx - j) < ramp + span] = 0.0
+        k = int(np.argmax(np.abs(d)))
+        if abs(d[k]) < max(STEP_MIN, STEP_SIGMA * noise):
+            break
+        # the plateau of d is a ramp wide: the step is where the adjacent means differ most
+        cand = np.arange(max(int(idx[k]) - half, span), min(int(idx[k]) + half + 1, t - span + 1))
+        j = int(idx[k])
+        if cand.size:
+            adj = (c[cand + span] - c[cand]) - (c[cand] - c[cand - span])
+            j = int(cand[np.argmax(np.abs(adj))])
+        lo, hi = max(j - half - span, 0), min(j + half + span, t)
+        per_bin = (c_bins[hi] - c_bins[hi - span]) / span - (c_bins[lo + span] - c_bins[lo]) / span
+        common = np.array([np.median(per_bin)])
+        tol = 4 * sigma * np.sqrt(2.0 / span)
+        if abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _agree(per_bin[:, None], common, tol, part) >= AGREE:
+            found.append(j)
+            cols.append((np.arange(t) >= j).astype(np.float64)[:, None])
+        else:
+            blocked.append(j)  # uneven along the wall: someone's shadow, kept
+    design = np.concatenate(cols, axis=1)
+    coef, *_ = np.linalg.lstsq(design, g, rcond=None)
+    nb = basis.shape[1]
+    drift = basis[:, 1:] @ coef[1:nb]
+    ptp = float(drift.max() - drift.min())
+    if ptp >= DRIFT_MIN:
+        cb, *_ = np.linalg.lstsq(design, rel, rcond=None)
+        per_bin = (basis[:, 1:] @ cb[1:nb]).T  # (K, T)
+        tol = 3 * sigma * np.sqrt((nb - 1) / t)
+        if _agree(per_bin, drift, tol, part) < AGREE:
+            ptp = 0.0
+    model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
+    steps = []
+    for j, size in zip(found, coef[nb:]):
+        model = model + size * (np.arange(t) >= j)
+        steps.append((j, float(size)))
+    for j, _ in steps:  # within a ramp the step's shape is what was measured, not a jump
+        lo, hi = max(j - half - 1, 0), min(j + half + 1, t)
+        model[lo:hi] = g[lo:hi] - np.median((g - model)[max(lo - span, 0):min(hi + span, t)])
+    return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
+
+
+# ------------------------------------------------------------------------------------ the fit
+@dataclass
+class Fit:
+    """Relative gains found on one stretch: multiply the raw levels by 1 / (1 + gain)."""
+
+    gain: np.ndarray  # (T, K) per sample and series
+    findings: list[dict[str, Any]]
+
+
+def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options(), t0: float = 0.0,
+        vertical: slice | None = None, part=None) -> Fit | None:
+    """The nuisances of a stretch of raw levels (T, K) (K series: profile bins, colours summed or
+    not; all positive levels of the same frames) sampled at ``rate``. ``lines``: the frequencies
+    where aliased mains flicker may show (:func:`mains_lines`). ``vertical``: which series are
+    the vertical profile (in order down the frame), for telling rolling-shutter bands; ``part``
+    (K,) which profile each series belongs to (a change of the light is alike along each).
+    None when nothing was found."""
+    levels = np.asarray(levels, np.float64)
+    t = levels.shape[0]
+    if t < MIN_SAMPLES or not options.any:
+        return None
+    mean = levels.mean(axis=0)
+    ok = mean > 1e-6 * max(float(np.abs(mean).max()), 1e-12)
+    if not ok.any():
+        return None
+    rel = np.zeros_like(levels)
+    rel[:, ok] = levels[:, ok] / mean[ok] - 1.0
+    gain = np.zeros_like(rel)
+    findings = []
+    if options.deflicker and lines:
+        line = _find_line(rel[:, ok], rate, lines)
+        if line is not None:
+            f, ratio = line
+            basis, coef = _sinusoids(rel, f, rate)
+            wave = basis @ coef
+            wave[:, ~ok] = 0.0
+            gain += wave
+            rel = (1.0 + rel) / (1.0 + wave) - 1.0
+            amp = np.hypot(coef[0], coef[1])[ok]
+            found = {"kind": "flicker", "hz": round(float(f), 3), "amplitude": float(np.median(amp)),
+                     "line_ratio": float(ratio)}
+            if vertical is not None:
+                v = np.arange(levels.shape[1])[vertical]
+                v = v[ok[v]]
+                if v.size >= 4:
+                    ph = np.unwrap(np.arctan2(coef[1, v], coef[0, v]))
+                    turn = float(abs(ph[-1] - ph[0]) / (2 * np.pi))
+                    found["rolling_shutter"] = turn >= 0.25
+                    found["bands"] = round(turn, 2)  # cycles of the bands over the profile's height
+            findings.append(found)
+    if options.exposure:
+        model, steps, drift = _steps_and_drift(rel[:, ok], rate, None if part is None else np.asarray(part)[ok])
+        model = model - np.mean(model)
+        if steps or drift:
+            gain = (1.0 + gain) * (1.0 + model[:, None]) - 1.0
+            if steps:
+                findings.append({"kind": "exposure", "steps": [{"time": round(t0 + j / rate, 3), "size": round(s, 5)}
+                                                               for j, s in steps]})
+            if drift:
+                findings.append({"kind": "drift", "amplitude": round(drift / 2, 5)})
+    if not findings:
+        return None
+    return Fit(gain, findings)
+
+
+# ------------------------------------------------------------------------------------ windows
+def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: float, *, lines=(),
+                    options: Options = Options(), starts=None, vertical_index: int | None = None):
+    """Correct plot windows in place of the classifiers' path.
+
+    ``parts``: [(n, bins, T, 3) windows relative to ``offsets`` [(n or 1, bins, 3)]] (e.g.
+    horizontal and vertical); all parts of a window are fitted together (a part that is all zero,
+    such as a vertical plot not computed, is left out). Returns (corrected parts (float32),
+    [findings per window]).
+    """
+    n = parts[0].shape[0]
+    out = [np.array(p, np.float32, copy=True) for p in parts]
+    found = [[] for _ in range(n)]
+    if not options.any:
+        return out, found
+    for w in range(n):
+        raws, used = [], []
+        for k, (p, off) in enumerate(zip(parts, offsets)):
+            x = p[w].astype(np.float64)
+            if not np.any(x):
+                continue
+            o = np.asarray(off, np.float64)
+            raw = x + o[min(w, o.shape[0] - 1)][:, None, :]  # (bins, T, 3)
+            raws.append(raw)
+            used.append(k)
+        if not raws:
+            continue
+        # colours summed: the nuisances are grey; (T, K) with K the bins of every part used
+        series = np.concatenate([r.sum(axis=-1).T for r in raws], axis=1)
+        vs = None
+        if vertical_index is not None and vertical_index in used:
+            start = sum(raws[i].shape[0] for i in range(used.index(vertical_index)))
+            vs = slice(start, start + raws[used.index(vertical_index)].shape[0])
+        t0 = 0.0 if starts is None else float(starts[w])
+        part = np.concatenate([np.full(r.shape[0], i) for i, r in enumerate(raws)])
+        res = fit(series, rate, lines=lines, options=options, t0=t0, vertical=vs, part=part)
+        if res is None:
+            continue
+        pos = 0
+        for k, raw in zip(used, raws):
+            b = raw.shape[0]
+            g = res.gain[:, pos:pos + b].T[:, :, None]  # (bins, T, 1)
+            pos += b
+            o = np.asarray(offsets[k], np.float64)[min(w, np.asarray(offsets[k]).shape[0] - 1)][:, None, :]
+            out[k][w] = (raw / (1.0 + g) - o).astype(np.float32)
+        found[w] = res.findings
+    return out, found
+
+
+def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
+    """A clip's ``corrections``: what its windows (or blocks) found, one entry per kind.
+
+    flicker: the median frequency and amplitude over the windows where it was found, and in how
+    many; exposure: every step once (windows overlap: steps within 1 s are one); drift: the
+    largest amplitude."""
+    flick = [f for fs in per_window for f in fs if f["kind"] == "flicker"]
+    out: list[dict[str, Any]] = []
+    if flick:
+        e = {"kind": "flicker", "hz": round(float(np.median([f["hz"] for f in flick])), 3),
+             "amplitude": round(float(np.median([f["amplitude"] for f in flick])), 6),
+             "windows": len(flick)}
+        rs = [f["rolling_shutter"] for f in flick if "rolling_shutter" in f]
+        if rs:
+            e["rolling_shutter"] = sum(rs) * 2 > len(rs)
+            e["bands"] = round(float(np.median([f["bands"] for f in flick if "bands" in f])), 2)
+        out.append(e)
+    steps = sorted((s for fs in per_window for f in fs if f["kind"] == "exposure" for s in f["steps"]),
+                   key=lambda s: s["time"])
+    if steps:
+        kept: list[list[dict]] = []
+        for s in steps:
+            if kept and s["time"] - kept[-1][-1]["time"] < 1.0:
+                kept[-1].append(s)
+            else:
+                kept.append([s])
+        out.append({"kind": "exposure", "steps": [
+            {"time": round(float(np.median([s["time"] for s in g])), 3),
+             "size": round(float(np.median([s["size"] for s in g])), 5)} for g in kept]})
+    drift = [f["amplitude"] for fs in per_window for f in fs if f["kind"] == "drift"]
+    if drift:
+        out.append({"kind": "drift", "amplitude": round(float(max(drift)), 5), "windows": len(drift)})
+    return out
+
+
+# ------------------------------------------------------------------------------------ streams
+class LaggedGains:
+    """:func:`fit` in a bounded running form, for consumers of whole frames (the SNR estimator):
+    push one profile (K,) per frame; get back (frame index, gain (K,)) for earlier frames.
+
+    Every ``hop`` frames the last ``window`` profiles are fitted and the gains of their middle
+    part are final (the first fit's also from frame 0, :meth:`flush` the rest), so each frame's
+    gain comes from a fit that saw ``(window - hop) / 2`` frames on either side of it; the lag
+    is at most ``hop + (window - hop) / 2`` frames, the memory ``window`` profiles.
+    """
+
+    def __init__(self, rate: float, *, lines=(), options: Options = Options(), window: int = 256,
+                 hop: int = 64, vertical: slice | None = None):
+        from collections import deque
+
+        self.rate, self.lines, self.options = float(rate), list(lines), options
+        self.window, self.hop, self.vertical = int(window), int(hop), vertical
+        self.margin = (self.window - self.hop) // 2
+        self._buf: deque = deque(maxlen=self.window)
+        self.count = 0  # frames pushed
+        self.done = 0  # frames whose gain was handed out
+        self.found: list[list[dict]] = []
+        self._flushed = False
+
+    def _fit(self, upto: int) -> list[tuple[int, np.ndarray]]:
+        levels = np.stack(self._buf)
+        first = self.count - levels.shape[0]
+        part = None
+        if self.vertical is not None:
+            part = np.ones(levels.shape[1], int)
+            part[self.vertical] = 0
+        res = fit(levels, self.rate, lines=self.lines, options=self.options, t0=first / self.rate,
+                  vertical=self.vertical, part=part)
+        if res is not None:
+            self.found.append(res.findings)
+        gains = res.gain if res is not None else np.zeros_like(levels)
+        out = [(i, gains[i - first]) for i in range(self.done, upto)]
+        self.done = upto
+        return out
+
+    def push(self, profile: np.ndarray) -> list[tuple[int, np.ndarray]]:
+        self._buf.append(np.asarray(profile, np.float64))
+        self.count += 1
+        if self.count >= self.window and (self.count - self.window) % self.hop == 0:
+            return self._fit(self.count - self.margin)
+        return []
+
+    def flush(self) -> list[tuple[int, np.ndarray]]:
+        """The gains of every frame not handed out yet (once)."""
+        if self._flushed or self.done >= self.count:
+            self._flushed = True
+            return []
+        self._flushed = True
+        if self.count < MIN_SAMPLES:
+            out = [(i, np.zeros(len(self._buf[0]))) for i in range(self.done, self.count)]
+            self.done = self.count
+            return out
+        return self._fit(self.count)
+
+    def corrections(self) -> list[dict[str, Any]]:
+        return merge(self.found)
+
+
+def bands(n: int, most: int = 64) -> np.ndarray:
+    """For ``n`` consecutive lines, the band (0..) each falls in, at most ``most`` bands."""
+    k = min(n, most)
+    return (np.arange(n) * k) // max(n, 1)
