@@ -51,8 +51,8 @@ MAX_STEPS = 4
 DRIFT_DEGREE = 3
 DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
 MIN_SAMPLES = 64  # shorter stretches are left alone
-UNEVEN = 0.25  # a bin's change within this fraction of the common one (plus its noise) is alike
-AGREE = 0.6  # fraction of the bins that must change alike for a step or drift to be the light's
+UNEVEN = 0.15  # a bin's change within this fraction of the common one (plus its noise) is alike
+AGREE = 0.75  # fraction of the bins that must change alike for a step or drift to be the light's
 
 
 @dataclass(frozen=True)
@@ -161,6 +161,39 @@ def _agree_one(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray) -> floa
     return float(np.mean(dev <= UNEVEN * size + tol))
 
 
+def _local_steps(rel: np.ndarray, j: int, half: int, span: int) -> np.ndarray:
+    """Each series' step at ``j``: a level, a slope and a step fitted to the ``span`` samples on
+    either side of the ramp (the slope takes up a person's slower change across it)."""
+    t = rel.shape[0]
+    idx = np.r_[max(j - half - span, 0):max(j - half, 0), min(j + half, t):min(j + half + span, t)]
+    x = (idx - j) / max(span, 1)
+    design = np.stack([np.ones_like(x), x, (idx >= j).astype(np.float64)], axis=1)
+    coef, *_ = np.linalg.lstsq(design, rel[idx], rcond=None)
+    return coef[2]
+
+
+def _rise(g: np.ndarray, j: int, half: int, span: int) -> int:
+    """Samples the change of ``g`` around ``j`` takes from 10 % to 90 % of the way between the
+    means of the ``span`` samples before and after it (a light's step is quick; the whole wall
+    dims or brightens as a person moves in front of a lamp over half a second or more)."""
+    t = g.size
+    lo, hi = max(j - half - span, 0), min(j + half + span, t)
+    before = g[lo:max(j - half, lo + 1)].mean()
+    after = g[min(j + half, hi - 1):hi].mean()
+    if after == before:
+        return t
+    k = np.convolve(g[lo:hi], np.ones(3) / 3, mode="same")
+    f = (k - before) / (after - before)
+    seg = f[1:-1]
+    above = np.flatnonzero(seg >= 0.9)
+    if above.size == 0:
+        return t
+    end = int(above[0])
+    below = np.flatnonzero(seg[:end] <= 0.1)
+    start = int(below[-1]) if below.size else 0
+    return end - start
+
+
 def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
     """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
     changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins. Steps
@@ -181,7 +214,6 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     ramp = max(2, int(round(RAMP_S * rate)))
     span = max(4, int(round(SPAN_S * rate)))
     half = ramp // 2
-    c_bins = np.concatenate([np.zeros((1, rel.shape[1])), np.cumsum(rel, axis=0)])
     for _ in range(2 * MAX_STEPS):
         if len(found) >= MAX_STEPS:
             break
@@ -206,11 +238,11 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         if cand.size:
             adj = (c[cand + span] - c[cand]) - (c[cand] - c[cand - span])
             j = int(cand[np.argmax(np.abs(adj))])
-        lo, hi = max(j - half - span, 0), min(j + half + span, t)
-        per_bin = (c_bins[hi] - c_bins[hi - span]) / span - (c_bins[lo + span] - c_bins[lo]) / span
+        per_bin = _local_steps(rel, j, half, span)
         common = np.array([np.median(per_bin)])
-        tol = 4 * sigma * np.sqrt(2.0 / span)
-        if abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _agree(per_bin[:, None], common, tol, part) >= AGREE:
+        tol = 3 * sigma * np.sqrt(2.0 / span)
+        if (abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _rise(g, j, half, span) <= ramp + 3
+                and _agree(per_bin[:, None], common, tol, part) >= AGREE):
             found.append(j)
             cols.append((np.arange(t) >= j).astype(np.float64)[:, None])
         else:
