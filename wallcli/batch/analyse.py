@@ -74,7 +74,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections, native_fps=float(info.fps))
                        for m in used]
         if classifiers:
-            vertical = any("vertical" in m.input_names for m in used)
+            vertical = any("vertical" in m.input_names for m in used) or corrections.any
             rows = RowStream(tee, bins=used[0].bins, fps=used[0].fps, vertical=vertical)
             for t, row in rows:
                 for c in classifiers:

@@ -40,13 +40,14 @@ def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> 
             "confident": confident, "reason": reason, "signal_db": signal_db}
 
 
-def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
-    """The plot's inputs for ``model`` at its canonical rate: ({name: (bins, T', 3)}, time (T',))."""
+def resampled_plots(model, plot, both: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The plot's inputs for ``model`` at its canonical rate: ({name: (bins, T', 3)}, time (T',));
+    ``both``: both plots, whatever the model reads (for the corrections)."""
     if plot.bins != model.bins:
         raise WallcliError(f"the space-time plot has {plot.bins} bins, the model needs {model.bins}",
                            hint=f"recompute it with 'wallcli stplot --bins {model.bins}'")
     out, grid = {}, None
-    for name in model.input_names:
+    for name in (("horizontal", "vertical") if both else model.input_names):
         out[name], grid = resample(getattr(plot, name), plot.time, model.fps)
     return out, grid
 
@@ -101,7 +102,7 @@ def _corrected(model, wins: dict, offsets: dict, native, options, starts=None):
 
 def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
-    plots, grid = resampled_plots(model, plot)
+    plots, grid = resampled_plots(model, plot, both=corrections.any)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     frames = len(grid) if plot.frames >= 2 else plot.frames
@@ -116,6 +117,7 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
         wins, f = _corrected(model, wins, {n: offsets[n][None] for n in wins}, native, corrections,
                              starts=[grid[s] for s in chunk])
         found += f
+        wins = {name: wins[name] for name in model.input_names}
         probs.append(model.predict({name: model.normalize(w, offsets[name][None]) for name, w in wins.items()}))
         signal.append(window_signal_db([(w, offsets[name][None]) for name, w in wins.items()]))
     return _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
@@ -129,8 +131,10 @@ def _predict_window(model, win: np.ndarray, ref: np.ndarray, *, start: float = 0
     b = model.bins
     parts = {"horizontal": win[:b], "vertical": win[b:]}
     refs = {"horizontal": ref[None, :b], "vertical": ref[None, b:]}
-    wins, found = _corrected(model, {n: parts[n][None] for n in model.input_names}, refs, native, options,
-                             starts=[start])
+    # the corrections read both profiles when the stream has them (a light's change is alike along
+    # both; rolling-shutter bands run down the vertical one), whatever the model reads
+    use = [n for n in ("horizontal", "vertical") if n in model.input_names or (options.any and np.any(parts[n]))]
+    wins, found = _corrected(model, {n: parts[n][None] for n in use}, refs, native, options, starts=[start])
     probs = model.predict({n: model.normalize(wins[n], refs[n]) for n in model.input_names})[0]
     return probs, float(window_signal_db([(wins[n], refs[n]) for n in model.input_names])[0]), found[0]
 
@@ -223,7 +227,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
         rows = RowStream(FrameTee(reader, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
-                         progress=progress, vertical=keep_plot or "vertical" in model.input_names)
+                         progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.any)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
@@ -281,7 +285,8 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     windower = StreamWindower(model.window, stride)
     check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps, vertical="vertical" in model.input_names)
+        rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps,
+                         vertical="vertical" in model.input_names or corrections.any)
         for t, row in rows:
             done = windower.push(t, row)
             if done is not None:

@@ -46,13 +46,14 @@ STEP_MIN = 0.003  # relative size of the smallest exposure step removed
 STEP_SIGMA = 10.0  # and in units of the gain's frame-to-frame noise
 RAMP_S = 0.33  # seconds an exposure step may take
 SPAN_S = 0.5  # seconds averaged on each side of a step
-GROUPS = 8  # the bins are judged alike in this many groups of neighbours (less noise than one by one)
 MAX_STEPS = 4
 DRIFT_DEGREE = 3
 DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
+DRIFT_AGREE = True  # drift only where most bins drifted alike
 MIN_SAMPLES = 64  # shorter stretches are left alone
-UNEVEN = 0.15  # a bin's change within this fraction of the common one (plus its noise) is alike
-AGREE = 0.75  # fraction of the bins that must change alike for a step or drift to be the light's
+UNEVEN = 0.2  # a bin's change within this fraction of the common one (plus its noise) is alike
+AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change alike for a step or drift
+AGREE_EACH = 0.5  # and in each profile
 
 
 @dataclass(frozen=True)
@@ -139,26 +140,23 @@ def _legendre(t: int, degree: int) -> np.ndarray:
     return np.polynomial.legendre.legvander(x, degree)
 
 
-def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None) -> float:
-    """:func:`_agree_one` for each profile (``part`` (K,) says which bin is whose), the least."""
-    if part is None:
-        return _agree_one(per_bin, common, tol)
-    return min(_agree_one(per_bin[part == p], common, tol[part == p]) for p in np.unique(part))
-
-
-def _agree_one(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray) -> float:
-    """The fraction of bins whose change (per_bin (K, ...)) is the common one (...) within
-    ``UNEVEN`` of it plus their own noise ``tol`` (K,): a change of the light multiplies every
-    bin alike, a person's shadow does not. Bins are pooled in ``GROUPS`` runs of neighbours first,
-    so that noisy bins cannot agree with anything."""
-    k = per_bin.shape[0]
-    g = min(GROUPS, k)
-    edges = (np.arange(g + 1) * k) // g
-    per_bin = np.stack([per_bin[a:b].mean(axis=0) for a, b in zip(edges[:-1], edges[1:])])
-    tol = np.array([np.sqrt(np.mean(np.square(tol[a:b])) / (b - a)) for a, b in zip(edges[:-1], edges[1:])])
-    dev = np.sqrt(np.mean(np.square(per_bin - common[None]).reshape(per_bin.shape[0], -1), axis=1))
+def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None) -> bool:
+    """Whether a change (per_bin (K, ...)) is the light's: in every profile (``part`` (K,) says
+    which bin is whose) at least ``AGREE_EACH`` and on average ``AGREE`` of the bins that can tell
+    (their noise ``tol`` (K,) under half the change) changed as the common one (...), within
+    ``UNEVEN`` of it plus their noise. A change of the light multiplies every bin alike; a person's
+    shadow does not, though it can dim all the rows (or all the columns) of a wall alike."""
+    part = np.zeros(per_bin.shape[0], int) if part is None else np.asarray(part)
     size = float(np.sqrt(np.mean(np.square(common))))
-    return float(np.mean(dev <= UNEVEN * size + tol))
+    dev = np.sqrt(np.mean(np.square(per_bin - common[None]).reshape(per_bin.shape[0], -1), axis=1))
+    fractions = []
+    for p in np.unique(part):
+        mine = part == p
+        tells = mine & (tol < 0.5 * size)
+        if tells.sum() < max(4, 0.5 * mine.sum()):
+            return False  # too noisy to tell a light's change from a person's
+        fractions.append(float(np.mean(dev[tells] <= UNEVEN * size + tol[tells])))
+    return min(fractions) >= AGREE_EACH and float(np.mean(fractions)) >= AGREE
 
 
 def _local_steps(rel: np.ndarray, j: int, half: int, span: int) -> np.ndarray:
@@ -240,9 +238,9 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
             j = int(cand[np.argmax(np.abs(adj))])
         per_bin = _local_steps(rel, j, half, span)
         common = np.array([np.median(per_bin)])
-        tol = 3 * sigma * np.sqrt(2.0 / span)
+        tol = 4 * sigma * np.sqrt(2.0 / span)
         if (abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _rise(g, j, half, span) <= ramp + 3
-                and _agree(per_bin[:, None], common, tol, part) >= AGREE):
+                and _agree(per_bin[:, None], common, tol, part)):
             found.append(j)
             cols.append((np.arange(t) >= j).astype(np.float64)[:, None])
         else:
@@ -256,7 +254,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         cb, *_ = np.linalg.lstsq(design, rel, rcond=None)
         per_bin = (basis[:, 1:] @ cb[1:nb]).T  # (K, T)
         tol = 3 * sigma * np.sqrt((nb - 1) / t)
-        if _agree(per_bin, drift, tol, part) < AGREE:
+        if DRIFT_AGREE and not _agree(per_bin, drift, tol, part):
             ptp = 0.0
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
     steps = []
