@@ -1,7 +1,7 @@
 """Do the corrections keep the clean clip's answers and SNR when a nuisance is injected?
 
 For each seed: ``wallcli simulate`` a clip (0-2 people, a random activity, 128x96, 10.5 s, 30 fps,
-lossless FFV1), then re-encode it (H.264 4:4:4, lossless) clean and with each nuisance of
+lossless FFV1), then re-encode it (FFV1 4:4:4 at 16 bits) clean and with each nuisance of
 ``wallcli.sim.inject`` at a stated strength, the same frames and camera noise. Every version is
 analysed as ``wallcli scan`` does (one decode: count, activity, snr) with the corrections on,
 and the nuisance versions also with them off. One JSON line per seed in OUT/results.jsonl
@@ -65,12 +65,12 @@ def run(out: Path, clips: int, seed0: int) -> None:
             cmd += ["--activity", act]
         subprocess.run(cmd, check=True, capture_output=True)
         line = {"seed": seed, "people": people, "activity": act if people else "none"}
-        clean = out / f"s{seed}-none.mp4"
+        clean = out / f"s{seed}-none.mkv"
         inject(src, clean, "none", strength=0.0)
         line["clean"] = _analyse(clean, models, True)
         line["clean_off"] = _analyse(clean, models, False)
         for kind, strength in NUISANCES.items():
-            p = out / f"s{seed}-{kind}.mp4"
+            p = out / f"s{seed}-{kind}.mkv"
             inject(src, p, kind, strength=strength, seed=seed)
             line[kind] = _analyse(p, models, True)
             line[kind + "_off"] = _analyse(p, models, False)

@@ -52,6 +52,7 @@ DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
 DRIFT_AGREE = True  # drift only where most bins drifted alike
 MIN_SAMPLES = 64  # shorter stretches are left alone
 UNEVEN = 0.2  # a bin's change within this fraction of the common one (plus its noise) is alike
+UNEVEN_DRIFT = 0.4  # the same for drift: a passing shadow bends a bin's slow curve (a cubic) a little
 AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change alike for a step or drift
 AGREE_EACH = 0.5  # and in each profile
 
@@ -140,12 +141,14 @@ def _legendre(t: int, degree: int) -> np.ndarray:
     return np.polynomial.legendre.legvander(x, degree)
 
 
-def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None) -> bool:
+def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None,
+           uneven: float = None) -> bool:
     """Whether a change (per_bin (K, ...)) is the light's: in every profile (``part`` (K,) says
     which bin is whose) at least ``AGREE_EACH`` and on average ``AGREE`` of the bins that can tell
     (their noise ``tol`` (K,) under half the change) changed as the common one (...), within
     ``UNEVEN`` of it plus their noise. A change of the light multiplies every bin alike; a person's
     shadow does not, though it can dim all the rows (or all the columns) of a wall alike."""
+    uneven = UNEVEN if uneven is None else uneven
     part = np.zeros(per_bin.shape[0], int) if part is None else np.asarray(part)
     size = float(np.sqrt(np.mean(np.square(common))))
     dev = np.sqrt(np.mean(np.square(per_bin - common[None]).reshape(per_bin.shape[0], -1), axis=1))
@@ -155,7 +158,7 @@ def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.nd
         tells = mine & (tol < 0.5 * size)
         if tells.sum() < max(4, 0.5 * mine.sum()):
             return False  # too noisy to tell a light's change from a person's
-        fractions.append(float(np.mean(dev[tells] <= UNEVEN * size + tol[tells])))
+        fractions.append(float(np.mean(dev[tells] <= uneven * size + tol[tells])))
     return min(fractions) >= AGREE_EACH and float(np.mean(fractions)) >= AGREE
 
 
@@ -207,6 +210,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     db = np.diff(rel, axis=0)
     sigma = 1.4826 * np.median(np.abs(db - np.median(db, axis=0)), axis=0) / np.sqrt(2.0)  # (K,) per bin
     found: list[int] = []
+    sizes: list[float] = []  # each step's size: the median of the bins' own (a shadow moves the joint fit's)
     blocked: list[int] = []
     cols = [basis]
     ramp = max(2, int(round(RAMP_S * rate)))
@@ -242,23 +246,24 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         if (abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _rise(g, j, half, span) <= ramp + 3
                 and _agree(per_bin[:, None], common, tol, part)):
             found.append(j)
+            sizes.append(float(common[0]))
             cols.append((np.arange(t) >= j).astype(np.float64)[:, None])
         else:
             blocked.append(j)  # uneven along the wall: someone's shadow, kept
-    design = np.concatenate(cols, axis=1)
-    coef, *_ = np.linalg.lstsq(design, g, rcond=None)
+    stepped = sum((size * (np.arange(t) >= j) for j, size in zip(found, sizes)), np.zeros(t))
     nb = basis.shape[1]
-    drift = basis[:, 1:] @ coef[1:nb]
+    coef, *_ = np.linalg.lstsq(basis, g - stepped, rcond=None)
+    drift = basis[:, 1:] @ coef[1:]
     ptp = float(drift.max() - drift.min())
     if ptp >= DRIFT_MIN:
-        cb, *_ = np.linalg.lstsq(design, rel, rcond=None)
+        cb, *_ = np.linalg.lstsq(basis, rel - stepped[:, None], rcond=None)
         per_bin = (basis[:, 1:] @ cb[1:nb]).T  # (K, T)
         tol = 3 * sigma * np.sqrt((nb - 1) / t)
-        if DRIFT_AGREE and not _agree(per_bin, drift, tol, part):
+        if DRIFT_AGREE and not _agree(per_bin, drift, tol, part, UNEVEN_DRIFT):
             ptp = 0.0
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
     steps = []
-    for j, size in zip(found, coef[nb:]):
+    for j, size in zip(found, sizes):
         model = model + size * (np.arange(t) >= j)
         steps.append((j, float(size)))
     for j, _ in steps:  # within a ramp the step's shape is what was measured, not a jump
@@ -424,7 +429,8 @@ class LaggedGains:
     Every ``hop`` frames the last ``window`` profiles are fitted and the gains of their middle
     part are final (the first fit's also from frame 0, :meth:`flush` the rest), so each frame's
     gain comes from a fit that saw ``(window - hop) / 2`` frames on either side of it; the lag
-    is at most ``hop + (window - hop) / 2`` frames, the memory ``window`` profiles.
+    is under ``window`` frames (``hop + (window - hop) / 2`` after the first fit), the memory
+    ``window`` profiles.
     """
 
     def __init__(self, rate: float, *, lines=(), options: Options = Options(), window: int = 256,

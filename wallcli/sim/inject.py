@@ -48,13 +48,17 @@ def gain_track(kind: str, frames: int, fps: float, height: int, *, strength: flo
 
 
 def inject(src: str | Path, dst: str | Path, kind: str, *, strength: float, seed: int = 0, **kw) -> np.ndarray:
-    """Write ``src`` with the nuisance to ``dst`` (H.264 4:4:4, lossless); returns the gains.
-    ``kind`` "none" re-encodes the clip alone (the fair clean reference: the same rounding). The
-    source is read as limited-range 4:4:4 planes."""
+    """Write ``src`` with the nuisance to ``dst`` (a .mkv: FFV1, 4:4:4 at 16 bits, lossless); returns
+    the gains. ``kind`` "none" re-encodes the clip alone (the clean reference).
+
+    The gain multiplies (Y - 16, U - 128, V - 128) of the limited-range planes, so exactly the RGB
+    code values whichever YUV matrix a reader applies (RGB is linear in them), and the result is
+    kept to 1/256 of a code value: rounding a small gain back to 8 bits would move every pixel of a
+    level at once (the source is already rounded, nothing dithers it) and draw steps that a real
+    camera, whose light changes before its noise and rounding, does not.
+    """
     import av
 
-    # the gain multiplies (Y - 16, U - 128, V - 128) of the limited-range planes: exactly the RGB
-    # code values, whichever YUV matrix a reader applies (RGB is linear in those)
     with av.open(str(src)) as c:
         stream = c.streams.video[0]
         fps = float(stream.average_rate or 30)
@@ -64,13 +68,14 @@ def inject(src: str | Path, dst: str | Path, kind: str, *, strength: float, seed
     gains = np.ones((len(frames), h)) if kind == "none" else gain_track(kind, len(frames), fps, h, strength=strength,
                                                                         rng=rng, **kw)
     zero = np.array([16.0, 128.0, 128.0])[:, None, None]
-    with av.open(str(dst), "w") as c:
-        s = c.add_stream("libx264", rate=int(round(fps)) if abs(fps - round(fps)) < 1e-6 else fps)
-        s.width, s.height, s.pix_fmt = w, h, "yuv444p"
-        s.options = {"qp": "0", "preset": "ultrafast"}
+    with av.open(str(dst), "w", format="matroska") as c:
+        s = c.add_stream("ffv1", rate=int(round(fps)) if abs(fps - round(fps)) < 1e-6 else fps)
+        s.width, s.height, s.pix_fmt = w, h, "yuv444p16le"
         for planes, g in zip(frames, gains):
-            x = np.clip(np.rint((planes - zero) * g[None, :, None] + zero), 0, 255).astype(np.uint8)
-            for p in s.encode(av.VideoFrame.from_ndarray(x, format="yuv444p")):
+            x = np.clip(np.rint(((planes - zero) * g[None, :, None] + zero) * 256.0), 0, 65535).astype(np.uint16)
+            frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(x.transpose(1, 2, 0)), format="yuv444p16le")
+            frame.color_range = 1  # limited (MPEG) range, as the planes are
+            for p in s.encode(frame):
                 c.mux(p)
         for p in s.encode():
             c.mux(p)
