@@ -451,6 +451,7 @@ class LaggedGains:
         self.done = 0  # frames whose gain was handed out
         self.found: list[list[dict]] = []
         self._flushed = False
+        self._prev: tuple[int, np.ndarray] | None = None  # the last fit: (first frame, gains)
 
     def _fit(self, upto: int) -> list[tuple[int, np.ndarray]]:
         levels = np.stack(self._buf)
@@ -464,6 +465,16 @@ class LaggedGains:
         if res is not None:
             self.found.append(res.findings)
         gains = res.gain if res is not None else np.zeros_like(levels)
+        # each fit's gains are relative to its own stretch's mean level; carry the previous fit's
+        # level over their overlap, or a step would reappear at every hop (its size times the
+        # change of the stretch's mean)
+        if self._prev is not None:
+            p0, prev = self._prev
+            lo, hi = max(first, p0), min(first + len(gains), p0 + len(prev))
+            if hi > lo:
+                factor = float(np.median((1.0 + prev[lo - p0:hi - p0]) / (1.0 + gains[lo - first:hi - first])))
+                gains = (1.0 + gains) * factor - 1.0
+        self._prev = (first, gains)
         out = [(i, gains[i - first]) for i in range(self.done, upto)]
         self.done = upto
         return out
