@@ -284,7 +284,6 @@ class SnrAccumulator:
 
     def _profile(self, x: np.ndarray) -> np.ndarray:
         """Row-band then column-band sums of the measured pixels (colours summed)."""
-        lat = self.lattice
         rows = x.sum(axis=(0, 3, 4)).reshape(-1)
         cols = x.sum(axis=(0, 1, 2)).reshape(-1)
         off = float(self._offset.sum())
