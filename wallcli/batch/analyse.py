@@ -28,10 +28,12 @@ class _Tee:
 
 
 def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
-            on_frame: Callable[[], None] | None = None) -> dict[str, Any]:
+            on_frame: Callable[[], None] | None = None, corrections=None) -> dict[str, Any]:
     """``{"frames", "duration", "fps", "warnings", "view", <task>: <its --json object>, ...}`` for ``source``.
 
     ``models``: a loaded :class:`~wallcli.infer.model.Model` per classification task asked for.
+    ``corrections``: :class:`~wallcli.signal.corrections.Options` (default: all on); what they
+    found is in each task's object and, for the video, under ``"corrections"`` (the first task's).
     ``on_frame`` is called after every decoded frame (a watchdog's heartbeat; it may raise to
     abandon the video). Raises WallcliError when the video cannot be read or is too short for a
     task: a video either has every answer asked for or none.
@@ -41,6 +43,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     from wallcli.infer.stream import RowStream
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
+    from wallcli.signal.corrections import Options
     from wallcli.signal.snr import SnrAccumulator, snr_report
     from wallcli.signal.view import ViewCheck
 
@@ -50,9 +53,11 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         raise WallcliError("the count and activity models read plots of different bins or frame rates; "
                            "one decode cannot feed both")
     state = {"frames": 0, "last": 0.0}
+    corrections = corrections if corrections is not None else Options()
     with open_video(source, threads=decoder_threads) as reader:
         info = reader.info
-        snr = SnrAccumulator(check_roi(None, info.width, info.height)) if "snr" in tasks else None
+        snr = SnrAccumulator(check_roi(None, info.width, info.height), corrections=corrections,
+                             fps=float(info.fps)) if "snr" in tasks else None
 
         check = ViewCheck()
 
@@ -66,9 +71,10 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
                 on_frame()
 
         tee = _Tee(reader, each)
-        classifiers = [WindowClassifier(m, int(m.card["stride"])) for m in used]
+        classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections, native_fps=float(info.fps))
+                       for m in used]
         if classifiers:
-            vertical = any("vertical" in m.input_names for m in used)
+            vertical = any("vertical" in m.input_names for m in used) or corrections.any
             rows = RowStream(tee, bins=used[0].bins, fps=used[0].fps, vertical=vertical)
             for t, row in rows:
                 for c in classifiers:
@@ -84,4 +90,5 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         out[task] = with_view(c.result(source), check)
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
+    out["corrections"] = next((out[t]["corrections"] for t in TASKS if t in out), [])
     return out

@@ -71,7 +71,8 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
              windows: bool = False, timeout: float = 300.0, encode: Callable[[dict], str],
              log: Callable[[str], None] = lambda m: None,
              on_start: Callable[[int, int], None] = lambda todo, skipped: None,
-             on_line: Callable[[dict], None] = lambda line: None, debug: bool = False) -> dict[str, Any]:
+             on_line: Callable[[dict], None] = lambda line: None, debug: bool = False,
+             deflicker: bool = True, exposure: bool = True) -> dict[str, Any]:
     """Scan every video named by ``inputs`` into ``output``; the summary of the run.
 
     ``on_start(todo, skipped)`` once the work is known; ``on_line(line)`` after each line is
@@ -100,7 +101,8 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
             log(f"{skipped} of {len(sources)} videos already in {out} (same sha256 and tasks): skipped; "
                 "--force redoes them")
         on_start(len(todo), skipped)
-        config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity())
+        config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity(),
+                            deflicker=deflicker, exposure=exposure)
         results.start(kept)
         t0 = time.perf_counter()
         if todo:

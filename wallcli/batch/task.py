@@ -25,6 +25,8 @@ class ScanConfig:
     timeout: float = 300.0  # seconds without a decoded frame before a video is given up; 0 = never
     decoder_threads: int = 1  # one core per worker: FFmpeg's own threads would only compete
     onnx_threads: int = 1
+    deflicker: bool = True  # the corrections (wallcli.signal.corrections) run on every video
+    exposure: bool = True
     # what the client runs (identity()); a worker that differs answers with an error line
     expected: dict = field(default_factory=dict)
 
@@ -149,7 +151,10 @@ def scan_video(source: str, config: ScanConfig) -> dict[str, Any]:
         def job(beat):
             if not is_url(source) and os.path.isfile(source):
                 line["size"], line["sha256"] = _hash(source, beat)
-            return analyse(source, config.tasks, models, decoder_threads=config.decoder_threads, on_frame=beat)
+            from wallcli.signal.corrections import Options
+
+            return analyse(source, config.tasks, models, decoder_threads=config.decoder_threads, on_frame=beat,
+                           corrections=Options(config.deflicker, config.exposure))
 
         out = run_with_watchdog(job, config.timeout)
     except (WallcliError, Stalled, OSError, MemoryError) as exc:
@@ -164,6 +169,7 @@ def scan_video(source: str, config: ScanConfig) -> dict[str, Any]:
             obj.pop("windows", None)
         line[task] = obj
     line["view"] = out["view"]
+    line["corrections"] = out["corrections"]
     line["warnings"] = out["warnings"]
     line["seconds"] = round(time.perf_counter() - t0, 3)
     line["error"] = None

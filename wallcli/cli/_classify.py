@@ -10,8 +10,8 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (ROI_HELP, force_help, input_argument, number_option, parse_roi, refuse_view,
-                                strict_option, threads_option)
+from wallcli.cli.common import (ROI_HELP, corrections_of, deflicker_option, exposure_option, force_help, input_argument,
+                                number_option, parse_roi, refuse_view, strict_option, threads_option)
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
@@ -26,14 +26,17 @@ ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
 FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
 INPUT_ARG = input_argument(INPUT_HELP)
 STRICT_OPT = strict_option()
+NO_DEFLICKER_OPT = deflicker_option()
+NO_EXPOSURE_OPT = exposure_option()
 
 
 def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
-        strict: bool = False) -> None:
+        strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False) -> None:
     from wallcli.errors import UsageError
 
     roi_t = parse_roi(roi)
+    fixes = corrections_of(no_deflicker, no_exposure)
     if follow and plot is not None:
         raise UsageError("--plot needs the whole clip; it cannot be combined with --follow")
     if follow and str(input).lower().endswith(".npz"):
@@ -51,7 +54,7 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     if follow:
         from wallcli.infer.classify import follow as follow_windows
 
-        for rec in follow_windows(model, input, stride=stride, roi=roi_t):
+        for rec in follow_windows(model, input, stride=stride, roi=roi_t, corrections=fixes):
             if strict:
                 refuse_view(input, rec.get("view"))
             emit_json(rec)
@@ -61,13 +64,13 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
 
     if str(input).lower().endswith(".npz"):
         st = load_plot(input, roi=roi_t, bins=model.bins)
-        result = classify_plot(model, st, stride=stride, source=str(input))
+        result = classify_plot(model, st, stride=stride, source=str(input), corrections=fixes)
     else:
         # a video is decoded once and classified window by window: memory does not grow with its
         # length (--plot keeps a copy of bounded size for drawing, see classify_video)
         with progress(task, None) as advance:
             result, st = classify_video(model, input, stride=stride, roi=roi_t,
-                                        progress=advance, keep_plot=plot is not None)
+                                        progress=advance, keep_plot=plot is not None, corrections=fixes)
     if strict:
         refuse_view(input, result.get("view"))
     with committed_together():  # the figure and the data on stdout: all or none

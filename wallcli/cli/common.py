@@ -130,3 +130,26 @@ def refuse_view(source, view) -> None:
         from wallcli.errors import WallcliError
 
         raise WallcliError(f"{source}: {view.get('reason') or 'not a static view of the wall'} (--strict)")
+
+
+DEFLICKER_HELP = ("Leave aliased mains flicker in. By default a narrow line where lamps' 100/120 Hz flicker "
+                  "lands at this frame rate (e.g. 10 Hz at 30 fps), whole-frame or as rolling-shutter bands, "
+                  "is found and removed before analysis, and listed under 'corrections' in the JSON.")
+EXPOSURE_HELP = ("Leave auto-exposure and gain steps and slow light drift in. By default whole-frame steps and "
+                 "drift slower than about 8 s are found, divided out before analysis, and listed under "
+                 "'corrections' in the JSON.")
+
+
+def deflicker_option():
+    return typer.Option(False, "--no-deflicker", help=DEFLICKER_HELP)
+
+
+def exposure_option():
+    return typer.Option(False, "--no-exposure", help=EXPOSURE_HELP)
+
+
+def corrections_of(no_deflicker: bool, no_exposure: bool):
+    """The corrections to run (wallcli.signal.corrections.Options) from the two options."""
+    from wallcli.signal.corrections import Options
+
+    return Options(deflicker=not no_deflicker, exposure=not no_exposure)

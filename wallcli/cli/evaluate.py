@@ -6,7 +6,8 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import MAX_THREADS, ROI_HELP, force_help, number_option, strict_option
+from wallcli.cli.common import (MAX_THREADS, ROI_HELP, corrections_of, deflicker_option, exposure_option, force_help,
+                                number_option, strict_option)
 
 PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
 
@@ -30,6 +31,8 @@ def evaluate(
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG, the only file evaluate writes,")),
     strict: bool = strict_option(),
+    no_deflicker: bool = deflicker_option(),
+    no_exposure: bool = exposure_option(),
 ) -> None:
     """Score a model on labelled clips: the check to run before relying on it for a room.
 
@@ -78,7 +81,8 @@ def evaluate(
     check_outputs([plot], force=force, inputs=[model, *(c.path for c in plan.labels.clips)])
     # delayed: on a small folder a bar would only flash; on a large one it shows the minutes left
     with progress(f"evaluate {task}", len(plan.kept), delay=PROGRESS_DELAY) as advance:
-        result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan)
+        result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan,
+                                 corrections=corrections_of(no_deflicker, no_exposure))
     if plot is not None:
         from wallcli.plots.reliability import save_reliability_png
 

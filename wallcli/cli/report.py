@@ -7,7 +7,8 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, parse_roi, refuse_view, strict_option, threads_option
+from wallcli.cli.common import (ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, force_help,
+                                parse_roi, refuse_view, strict_option, threads_option)
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
 
@@ -22,6 +23,8 @@ def report(
     force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
     strict: bool = strict_option(),
+    no_deflicker: bool = deflicker_option(),
+    no_exposure: bool = exposure_option(),
 ) -> None:
     """Write one HTML page that opens offline in any browser and can be handed over as it is.
 
@@ -75,7 +78,8 @@ def report(
 
         models = load_models(count_model, activity_model)
         with progress("report", None) as advance:
-            analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance)
+            analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance,
+                               corrections=corrections_of(no_deflicker, no_exposure))
         if strict:
             refuse_view(input, analysis.view)
         for w in analysis.warnings:

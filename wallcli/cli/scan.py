@@ -7,7 +7,7 @@ from typing import List, Optional
 
 import typer
 
-from wallcli.cli.common import MAX_THREADS, number_option, strict_option
+from wallcli.cli.common import MAX_THREADS, deflicker_option, exposure_option, number_option, strict_option
 
 
 def scan(
@@ -35,6 +35,8 @@ def scan(
                                   "produces no frame for this many seconds. 0: wait forever."),
     json_out: bool = typer.Option(False, "--json", help="Print the run's summary as one JSON object on stdout."),
     strict: bool = strict_option(),
+    no_deflicker: bool = deflicker_option(),
+    no_exposure: bool = exposure_option(),
 ) -> None:
     """Analyse many videos into one results file: one line per video, as each finishes.
 
@@ -85,7 +87,8 @@ def scan(
     with _Bar() as bar:
         summary = run_scan(inputs, output, tasks=tasks, workers=workers, scheduler=scheduler, globs=glob,
                            force=force, windows=windows, timeout=timeout, encode=to_json, log=lambda m: log(m, wrap=False),
-                           on_start=bar.start, on_line=on_line, debug=debug)
+                           on_start=bar.start, on_line=on_line, debug=debug,
+                           deflicker=not no_deflicker, exposure=not no_exposure)
     from wallcli.wording import plural
 
     log(f"scan: {plural(summary['videos'], 'video')}: {summary['ok']} done, {summary['failed']} failed, "

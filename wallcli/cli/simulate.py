@@ -79,6 +79,9 @@ def simulate(
     drift: Optional[float] = number_option(None, "--drift", lo=0, hi=0.5, help="Slow light drift, relative amplitude (e.g. 0.005)."),
     flicker: Optional[float] = number_option(None, "--flicker", lo=0, hi=0.5, help="Mains flicker, relative amplitude, aliased to the frame rate."),
     mains: Optional[float] = number_option(None, "--mains", lo=50, hi=60, help="Mains frequency for flicker: 50 or 60 Hz."),
+    rolling_shutter: Optional[float] = number_option(None, "--rolling-shutter", lo=0, hi=1, help="Rolling-shutter readout time as a "
+                                                     "fraction of the frame interval: --flicker then shows as bright and dark "
+                                                     "bands that travel down the frame (0 = global shutter, the default)."),
     ae_steps: Optional[int] = number_option(None, "--ae-steps", lo=0, hi=10, integer=True, help="Number of auto-exposure steps (each 0.5-3 %)."),
     shake: Optional[float] = number_option(None, "--shake", lo=0, hi=5, help="Camera shake, rms pixels (sub-pixel, e.g. 0.1)."),
     nuisances: float = number_option(0.0, "--nuisances", lo=0, hi=1, help="Probability that random drift/flicker/AE steps/shake "
@@ -158,7 +161,7 @@ def simulate(
 
 def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, world, domain, dist, spd, level, iso_gain,
            read_noise, sensor_pixels, prnu, gamma, noise_scale, drift, flicker, mains, ae_steps, shake, nuisances,
-           preview, json_out, force, acts, suffix, spp, **_):
+           preview, json_out, force, acts, suffix, spp, rolling_shutter=None, **_):
     import json
 
     from wallcli.cli.output import progress
@@ -168,7 +171,8 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
     sidecar = output.with_suffix(".json")
     check_outputs([output, sidecar, preview], force=force)
     overrides = {k: v for k, v in dict(level=level, gain=iso_gain, read_noise=read_noise, prnu=prnu, gamma=gamma, drift=drift,
-                                         flicker=flicker, mains=mains, ae_steps=ae_steps, shake=shake).items() if v is not None}
+                                         flicker=flicker, mains=mains, ae_steps=ae_steps, shake=shake,
+                                         rolling_shutter=rolling_shutter).items() if v is not None}
     overrides["sensor_pixels"] = float(sensor_pixels) if sensor_pixels else float(w * h)
     codec = "ffv1" if suffix == ".mkv" else ("rawvideo" if suffix == ".y4m" else "libx264")
     if world == "flatland":

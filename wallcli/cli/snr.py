@@ -8,7 +8,8 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import THREADS_HELP, Number, force_help, number_option, strict_option, threads_option
+from wallcli.cli.common import (THREADS_HELP, Number, corrections_of, deflicker_option, exposure_option, force_help,
+                                number_option, strict_option, threads_option)
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
 # checks the option and every value of a --sweep alike.
@@ -75,6 +76,8 @@ def snr(
     force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
     strict: bool = strict_option(),
+    no_deflicker: bool = deflicker_option(),
+    no_exposure: bool = exposure_option(),
 ) -> None:
     """Measure the wall signal and the noise in a video, per colour channel (Sharma et al., What
     You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §3.2).
@@ -109,11 +112,13 @@ def snr(
         raise UsageError("--sweep goes with --predict")
     with committed_together():
         _measure(input, roi=roi, json_out=json_out, heatmap=heatmap, heatmap_of=heatmap_of, plot=plot,
-                 max_pixels=max_pixels, force=force, threads=threads, strict=strict)
+                 max_pixels=max_pixels, force=force, threads=threads, strict=strict,
+                 corrections=corrections_of(no_deflicker, no_exposure))
 
 
 # ------------------------------------------------------------------------------------- measure
-def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, force, threads, strict=False) -> None:
+def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, force, threads, strict=False,
+             corrections=None) -> None:
     import warnings
 
     from wallcli.cli.common import parse_roi
@@ -146,7 +151,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     with open_video(input, threads=threads) as reader, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         roi_c = check_roi(roi_t, reader.info.width, reader.info.height)
-        acc = SnrAccumulator(roi_c, max_pixels=max_pixels)
+        acc = SnrAccumulator(roi_c, max_pixels=max_pixels, corrections=corrections, fps=float(reader.info.fps))
         if heatmap is not None and grid is None:
             grid = GridAccumulator(roi_c, 48)
         feed_grid = grid if (grid is not None and not auto) else None

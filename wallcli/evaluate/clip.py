@@ -37,11 +37,14 @@ def plot_block(roi, bins: int, blocks) -> int:
     return min(blocks, key=lambda n: (abs(math.log(n * n / area)), n))
 
 
-def measure_clip(model, path: str | Path, *, stride: int, roi=None, threads: int = 0) -> dict[str, Any]:
+def measure_clip(model, path: str | Path, *, stride: int, roi=None, threads: int = 0, corrections=None) -> dict[str, Any]:
     """{'result': the classifier's clip-level result (without its windows), 'snr_db', 'snr_block',
     'warnings'}. Raises WallcliError for a clip that cannot be analysed (missing, corrupt, too short)."""
     from wallcli.infer.classify import classify_plot, classify_video, load_plot
+    from wallcli.signal.corrections import Options
     from wallcli.signal.snr import FrameSnr
+
+    corrections = corrections if corrections is not None else Options()
 
     path = Path(path)
     if not path.exists():
@@ -50,16 +53,19 @@ def measure_clip(model, path: str | Path, *, stride: int, roi=None, threads: int
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if path.suffix.lower() == ".npz":  # a space-time plot: the answer, but no pixels to measure
-            result = classify_plot(model, load_plot(path, roi=roi, bins=model.bins), stride=stride, source=str(path))
+            result = classify_plot(model, load_plot(path, roi=roi, bins=model.bins), stride=stride, source=str(path),
+                                   corrections=corrections)
         else:
-            tap = FrameSnr(roi)
-            result, _ = classify_video(model, str(path), stride=stride, roi=roi, threads=threads, taps=(tap,))
+            tap = FrameSnr(roi, corrections=corrections)
+            result, _ = classify_video(model, str(path), stride=stride, roi=roi, threads=threads, taps=(tap,),
+                                       corrections=corrections)
             res = tap.result()
             block = plot_block(res.roi, model.bins, [s.block for s in res.scales])
             snr_db = float(res.scale(block).snr_db[GREEN])
     result = dict(result)
     result["windows_n"] = len(result.pop("windows"))
     return {"result": result, "snr_db": snr_db, "snr_block": block,
+            "snr_corrections": tap.acc.corrections if snr_db is not None and tap.acc is not None else None,
             "warnings": [" ".join(str(w.message).split()) for w in caught]}
 
 
@@ -67,7 +73,7 @@ def measure_clip(model, path: str | Path, *, stride: int, roi=None, threads: int
 _WORKER: dict[str, Any] = {}
 
 
-def init_worker(task: str, model_path: str, stride: int, roi) -> None:
+def init_worker(task: str, model_path: str, stride: int, roi, corrections=None) -> None:
     """Per process: the model loaded (and hash-checked) once, onnxruntime on one thread (the
     processes share out the cores). Ctrl-C is the parent's to handle: it stops the pool."""
     import os
@@ -77,13 +83,14 @@ def init_worker(task: str, model_path: str, stride: int, roi) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     from wallcli.infer.model import Model
 
-    _WORKER.update(model=Model.load(model_path, task=task, threads=1), stride=stride, roi=roi)
+    _WORKER.update(model=Model.load(model_path, task=task, threads=1), stride=stride, roi=roi, corrections=corrections)
 
 
 def run_clip(path: str) -> dict[str, Any]:
     """:func:`measure_clip` in a worker; a failure is returned as {'error': one line}, not raised."""
     try:
-        return measure_clip(_WORKER["model"], path, stride=_WORKER["stride"], roi=_WORKER["roi"], threads=1)
+        return measure_clip(_WORKER["model"], path, stride=_WORKER["stride"], roi=_WORKER["roi"], threads=1,
+                            corrections=_WORKER.get("corrections"))
     except WallcliError as exc:
         return {"error": _one_line(str(exc))}
     except MemoryError:

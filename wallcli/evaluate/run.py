@@ -53,7 +53,7 @@ def default_jobs() -> int:
 
 def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | None = None, roi=None,
                     jobs: int = 0, progress: Callable[[int], None] | None = None, min_snr: float | None = None,
-                    plan: Plan | None = None) -> dict[str, Any]:
+                    plan: Plan | None = None, corrections=None) -> dict[str, Any]:
     """Run ``task``'s model (the shipped one, or ``model_path``) on every labelled clip of ``folder``
     in ``jobs`` processes (0: one per core) and score it. A clip that fails is a row with its
     error (and a wrong answer); labels that cannot be read raise WallcliError. ``min_snr``: score
@@ -83,7 +83,7 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
                 progress(1)
     if todo:
         n = jobs or default_jobs()
-        initargs = (task, str(model.path), stride, tuple(roi) if roi else None)
+        initargs = (task, str(model.path), stride, tuple(roi) if roi else None, corrections)
         with closing(imap_isolated(run_clip, [str(kept[i].path) for i in todo], jobs=n,
                                    initializer=init_worker, initargs=initargs)) as results:
             for k, value in results:
@@ -126,6 +126,7 @@ def _row(clip: Clip, out: dict, task: str, has_snr: bool) -> dict[str, Any]:
         "error": err,
         "reason": res.get("reason") if res else None,
         "view": res.get("view") if res else None,  # None for a .npz: no pixels to check
+        "corrections": res.get("corrections") if res else None,
         "snr_block": out.get("snr_block"),
         "windows": res.get("windows_n") if res else None,
         "warnings": out.get("warnings", []),

@@ -18,6 +18,7 @@ import numpy as np
 
 from wallcli.errors import WallcliError
 from wallcli.infer.confidence import judge
+from wallcli.signal import corrections as corr
 from wallcli.signal.window import StreamWindower, resample, window_signal_db, window_starts
 
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
@@ -39,20 +40,22 @@ def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> 
             "confident": confident, "reason": reason, "signal_db": signal_db}
 
 
-def resampled_plots(model, plot) -> tuple[dict[str, np.ndarray], np.ndarray]:
-    """The plot's inputs for ``model`` at its canonical rate: ({name: (bins, T', 3)}, time (T',))."""
+def resampled_plots(model, plot, both: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The plot's inputs for ``model`` at its canonical rate: ({name: (bins, T', 3)}, time (T',));
+    ``both``: both plots, whatever the model reads (for the corrections)."""
     if plot.bins != model.bins:
         raise WallcliError(f"the space-time plot has {plot.bins} bins, the model needs {model.bins}",
                            hint=f"recompute it with 'wallcli stplot --bins {model.bins}'")
     out, grid = {}, None
-    for name in model.input_names:
+    for name in (("horizontal", "vertical") if both else model.input_names):
         out[name], grid = resample(getattr(plot, name), plot.time, model.fps)
     return out, grid
 
 
-def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict[str, Any]:
-    """The docs/contract.md result from window start times, their probabilities (n, classes) and
-    measured signals (n,) in dB."""
+def _result(model, times, probs, signal_db, *, stride: int, source: str, found=None) -> dict[str, Any]:
+    """The docs/contract.md result from window start times, their probabilities (n, classes),
+    measured signals (n,) in dB and what each window's corrections found (``found``)."""
+    found = found if found is not None else [[] for _ in times]
     clip = probs.mean(axis=0)
     clip = clip / clip.sum()
     clip_db = round(float(np.mean(signal_db)), 2)
@@ -70,37 +73,70 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str) -> dict
         "signal_db": clip_db,
         "stride": int(stride),
         "window": model.window,
-        "windows": [_window_record(model, t, pr, db) for t, pr, db in zip(times, probs, signal_db)],
+        "corrections": corr.merge(found),
+        "windows": [_window_record(model, t, pr, db) | {"corrections": corr.merge([f])}
+                    for t, pr, db, f in zip(times, probs, signal_db, found)],
     }
 
 
-def classify_plot(model, plot, *, stride: int, source: str) -> dict[str, Any]:
+def native_fps(time) -> float | None:
+    """The frame rate of a plot's own timestamps (before resampling), None when unknown."""
+    time = np.asarray(time, np.float64)
+    if time.size < 3:
+        return None
+    d = float(np.median(np.diff(time)))
+    return 1.0 / d if d > 0 else None
+
+
+def _corrected(model, wins: dict, offsets: dict, native, options, starts=None):
+    """(windows, findings per window): ``wins`` {name: (n, bins, W, 3)} with the whole-frame light
+    nuisances of :mod:`wallcli.signal.corrections` divided out (all of a window's parts together)."""
+    names = list(wins)
+    if not options.any:
+        return wins, [[] for _ in range(next(iter(wins.values())).shape[0])]
+    parts, found = corr.correct_windows([wins[n] for n in names], [offsets[n] for n in names], model.fps,
+                                        lines=corr.mains_lines(native, model.fps), options=options, starts=starts,
+                                        vertical_index=names.index("vertical") if "vertical" in names else None)
+    return dict(zip(names, parts)), found
+
+
+def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
-    plots, grid = resampled_plots(model, plot)
+    plots, grid = resampled_plots(model, plot, both=corrections.any)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     frames = len(grid) if plot.frames >= 2 else plot.frames
     starts = window_starts(frames, model.window, stride)
     if not starts:
         raise _too_short(source, frames, model)
-    probs, signal = [], []
+    probs, signal, found = [], [], []
+    native = native_fps(plot.time)
     for i in range(0, len(starts), CHUNK):
         chunk = starts[i:i + CHUNK]
         wins = {name: np.stack([p[:, s:s + model.window] for s in chunk]) for name, p in plots.items()}
+        wins, f = _corrected(model, wins, {n: offsets[n][None] for n in wins}, native, corrections,
+                             starts=[grid[s] for s in chunk])
+        found += f
+        wins = {name: wins[name] for name in model.input_names}
         probs.append(model.predict({name: model.normalize(w, offsets[name][None]) for name, w in wins.items()}))
         signal.append(window_signal_db([(w, offsets[name][None]) for name, w in wins.items()]))
     return _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
-                   stride=stride, source=source)
+                   stride=stride, source=source, found=found)
 
 
-def _predict_window(model, win: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, float]:
-    """(probabilities, signal dB) of one (2*bins, window, 3) window, horizontal rows first; ``ref``
-    (2*bins, 3) is the level the stream's rows are relative to (RowStream.ref)."""
+def _predict_window(model, win: np.ndarray, ref: np.ndarray, *, start: float = 0.0, native=None,
+                    options: corr.Options = corr.Options()) -> tuple[np.ndarray, float, list]:
+    """(probabilities, signal dB, corrections found) of one (2*bins, window, 3) window, horizontal
+    rows first; ``ref`` (2*bins, 3) is the level the stream's rows are relative to (RowStream.ref)."""
     b = model.bins
     parts = {"horizontal": win[:b], "vertical": win[b:]}
     refs = {"horizontal": ref[None, :b], "vertical": ref[None, b:]}
-    probs = model.predict({n: model.normalize(parts[n][None], refs[n]) for n in model.input_names})[0]
-    return probs, float(window_signal_db([(parts[n][None], refs[n]) for n in model.input_names])[0])
+    # the corrections read both profiles when the stream has them (a light's change is alike along
+    # both; rolling-shutter bands run down the vertical one), whatever the model reads
+    use = [n for n in ("horizontal", "vertical") if n in model.input_names or (options.any and np.any(parts[n]))]
+    wins, found = _corrected(model, {n: parts[n][None] for n in use}, refs, native, options, starts=[start])
+    probs = model.predict({n: model.normalize(wins[n], refs[n]) for n in model.input_names})[0]
+    return probs, float(window_signal_db([(wins[n], refs[n]) for n in model.input_names])[0]), found[0]
 
 
 class WindowClassifier:
@@ -112,10 +148,11 @@ class WindowClassifier:
     (the level they are relative to).
     """
 
-    def __init__(self, model, stride: int):
+    def __init__(self, model, stride: int, *, corrections: corr.Options = corr.Options(), native_fps=None):
         self.model, self.stride = model, int(stride)
+        self.corrections, self.native_fps = corrections, native_fps  # native_fps: the video's own rate
         self.windower = StreamWindower(model.window, stride)
-        self.times, self.probs, self.signal = [], [], []
+        self.times, self.probs, self.signal, self.found = [], [], [], []
         self.ref = None
         self._emitted = 0  # rows seen when the newest window was classified
 
@@ -123,10 +160,12 @@ class WindowClassifier:
         self.ref = ref
         done = self.windower.push(t, row)
         if done is not None:
-            p, db = _predict_window(self.model, done[2], ref)
+            p, db, f = _predict_window(self.model, done[2], ref, start=done[0], native=self.native_fps,
+                                       options=self.corrections)
             self.times.append(done[0])
             self.probs.append(p)
             self.signal.append(db)
+            self.found.append(f)
             self._emitted = self.windower.count
 
     def result(self, source: str) -> dict[str, Any]:
@@ -135,13 +174,16 @@ class WindowClassifier:
         last = w.last()
         if last is None:
             raise _too_short(str(source), w.count, model)
-        times, probs, signal = list(self.times), list(self.probs), list(self.signal)
+        times, probs, signal, found = list(self.times), list(self.probs), list(self.signal), list(self.found)
         if self._emitted != w.count:  # window_starts' end-aligned window: the last `window` rows
-            p, db = _predict_window(model, last[2], self.ref)
+            p, db, f = _predict_window(model, last[2], self.ref, start=last[0], native=self.native_fps,
+                                       options=self.corrections)
             times.append(last[0])
             probs.append(p)
             signal.append(db)
-        return _result(model, times, np.stack(probs), np.asarray(signal), stride=self.stride, source=str(source))
+            found.append(f)
+        return _result(model, times, np.stack(probs), np.asarray(signal), stride=self.stride, source=str(source),
+                       found=found)
 
 
 def judge_view(rec: dict[str, Any], view: dict) -> dict[str, Any]:
@@ -162,7 +204,7 @@ def with_view(result: dict[str, Any], check) -> dict[str, Any]:
 
 
 def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 0, progress=None,
-                   keep_plot: bool = False, taps=()):
+                   keep_plot: bool = False, taps=(), corrections: corr.Options = corr.Options()):
     """(result, plot) for a video, decoded once into windows classified as they complete.
 
     Gives the windows of :func:`classify_plot` on the same video (the end-aligned last one
@@ -176,12 +218,16 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.infer.stream import PlotThumbnail, RowStream
     from wallcli.signal.view import ViewCheck
 
-    classifier = WindowClassifier(model, stride)
+    classifier = WindowClassifier(model, stride, corrections=corrections)
     thumb = PlotThumbnail() if keep_plot else None
     check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
+        classifier.native_fps = float(reader.info.fps)
+        for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
+            if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
+                tap.fps = float(reader.info.fps)
         rows = RowStream(FrameTee(reader, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
-                         progress=progress, vertical=keep_plot or "vertical" in model.input_names)
+                         progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.any)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
@@ -225,7 +271,8 @@ def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64,
         return compute_stplot(reader, roi=roi, bins=bins, mean="clip", progress=progress)
 
 
-def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> Iterator[dict[str, Any]]:
+def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
+           corrections: corr.Options = corr.Options()) -> Iterator[dict[str, Any]]:
     """One result per window, yielded as soon as its last frame is decoded.
 
     Rows are raw (not clip-mean-removed): ``normalize_window`` removes each window's own
@@ -238,11 +285,14 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0) -> It
     windower = StreamWindower(model.window, stride)
     check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps, vertical="vertical" in model.input_names)
+        rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps,
+                         vertical="vertical" in model.input_names or corrections.any)
         for t, row in rows:
             done = windower.push(t, row)
             if done is not None:
-                rec = _window_record(model, done[0], *_predict_window(model, done[2], rows.ref))
+                p, db, found = _predict_window(model, done[2], rows.ref, start=done[0], native=float(reader.info.fps),
+                                               options=corrections)
+                rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
                 yield judge_view(rec, check.view(rec["start"], rec["end"]))
     if windower.count < model.window:
         raise _too_short(str(source), windower.count, model)

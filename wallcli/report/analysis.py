@@ -47,8 +47,8 @@ class _Tee:
     compute_stplot: a container may announce a wrong size).
     """
 
-    def __init__(self, reader, roi):
-        self._reader, self._requested = reader, roi
+    def __init__(self, reader, roi, corrections=None):
+        self._reader, self._requested, self._corrections = reader, roi, corrections
         self.info = reader.info
         self.snr = self.grid = self.first = None
         from wallcli.signal.view import ViewCheck
@@ -67,7 +67,8 @@ class _Tee:
             planes = frame.planes
             if self.snr is None:
                 roi = check_roi(self._requested, planes.width, planes.height)
-                self.snr = SnrAccumulator(roi, max_pixels=DEFAULT_MAX_PIXELS)
+                self.snr = SnrAccumulator(roi, max_pixels=DEFAULT_MAX_PIXELS, corrections=self._corrections,
+                                          fps=float(self.info.fps))
                 self.grid = GridAccumulator(roi, HEATMAP_CELLS)
                 self.first = planes.rgb()
             self.snr.update(planes)
@@ -110,7 +111,7 @@ def load_models(count_model=None, activity_model=None, threads: int = 0) -> dict
 
 
 def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
-            progress: Callable[[int], None] | None = None) -> ClipAnalysis:
+            progress: Callable[[int], None] | None = None, corrections=None) -> ClipAnalysis:
     """Decode ``source`` once and measure, plot and classify it (see the module's docstring)."""
     import warnings
 
@@ -123,10 +124,12 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     facts = file_facts(source)
     with warnings.catch_warnings(record=True) as caught, open_video(source, threads=threads) as reader:
         warnings.simplefilter("always")
-        tee = _Tee(reader, roi)
+        tee = _Tee(reader, roi, corrections)
         plot = compute_stplot(tee, roi=roi, bins=models["count"].bins, mean="clip", progress=progress)
         info = reader.info
     notes = list(dict.fromkeys([str(w.message) for w in caught] + list(plot.meta.get("warnings", []))))
+    if tee.snr is not None:
+        tee.snr.finish()  # frames still waiting for their corrections' gains
     if tee.snr.frames < 3:
         raise WallcliError(f"{source}: only {tee.snr.frames} frame(s) decoded; the noise estimate needs at least 3")
     snr = tee.snr.result()
@@ -157,7 +160,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     for task in TASKS:
         model = models[task]
         try:
-            out.results[task] = with_view(classify_plot(model, plot, stride=int(model.card["stride"]), source=str(source)),
+            out.results[task] = with_view(classify_plot(model, plot, stride=int(model.card["stride"]), source=str(source),
+                                                        **({"corrections": corrections} if corrections is not None else {})),
                                           tee.view)
         except WallcliError as exc:  # too short for one window: the rest of the report still stands
             out.failures[task] = str(exc)

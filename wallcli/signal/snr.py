@@ -205,14 +205,28 @@ def powers_from_sums(s1, s2, sd, dsum, frames: int, area: float, axes) -> tuple[
 
 # ---------------------------------------------------------------------------------- estimator
 class SnrAccumulator:
-    """Feed decoded frames' planes with :meth:`update`; :meth:`result` gives every block size."""
+    """Feed decoded frames' planes with :meth:`update`; :meth:`result` gives every block size.
 
-    def __init__(self, roi: Roi, *, max_pixels: int = DEFAULT_MAX_PIXELS, scales=SCALES):
+    With ``corrections`` (:class:`wallcli.signal.corrections.Options`) and the video's frame rate
+    ``fps``, the whole-frame light nuisances (aliased mains flicker, exposure steps, drift) are
+    found on the measured pixels' row and column means and divided out of every pixel before the
+    sums (each pixel by the gain of its row band, so rolling-shutter bands go too). The gains are
+    final a few seconds later (:class:`~wallcli.signal.corrections.LaggedGains`), so that many
+    frames' measured pixels wait in memory; :attr:`corrections` says what was found.
+    """
+
+    def __init__(self, roi: Roi, *, max_pixels: int = DEFAULT_MAX_PIXELS, scales=SCALES, corrections=None,
+                 fps: float | None = None):
         self.roi_requested = roi
         self.max_pixels = int(max_pixels)
         self.scales = tuple(scales)
         self.frames = 0
         self.warnings: list[str] = []
+        self.options = corrections if corrections is not None and corrections.any and fps else None
+        self.fps = fps
+        self.gains = None
+        self._waiting = None
+        self._ready = False
 
     def _setup(self, planes) -> None:
         self.fy, self.fx = footprint(planes)
@@ -225,6 +239,23 @@ class SnrAccumulator:
         self.chroma = planes.u is not None
         lat = self.lattice
         self.levels = [n for n in self.scales if lat.th // n >= 1 and lat.tw // n >= 1]
+        if self.options is not None:
+            from collections import deque
+
+            from wallcli.signal import corrections as corr
+
+            self.row_band = corr.bands(lat.nty * lat.th)
+            self.col_band = corr.bands(lat.ntx * lat.tw)
+            nr, nc = int(self.row_band[-1]) + 1, int(self.col_band[-1]) + 1
+            self.gains = corr.LaggedGains(float(self.fps), lines=corr.mains_lines(self.fps, float(self.fps)),
+                                          options=self.options, vertical=slice(0, nr))
+            self._waiting = deque()
+            self._nr, self._nc = nr, nc
+            # the measured values leave out RGB's affine offset (variances do not need it); a
+            # multiplicative change of the light multiplies the values with it
+            self._offset = np.asarray(planes.rgb_affine(chroma=planes.u is not None)[1], np.float32)
+            self._row_px = np.bincount(self.row_band, minlength=nr) * (lat.ntx * lat.tw)
+            self._col_px = np.bincount(self.col_band, minlength=nc) * (lat.nty * lat.th)
 
     def _rgb(self, planes) -> np.ndarray:
         """The measured pixels as float32 RGB, shape (3, nty, th, ntx, tw)."""
@@ -246,10 +277,49 @@ class SnrAccumulator:
             o += (m[c, 1] * u + m[c, 2] * v)[:, :, None, :, :, None]
         return out
 
+    @property
+    def corrections(self) -> list[dict]:
+        """What the corrections found and removed (the JSON ``corrections``), [] without them."""
+        return self.gains.corrections() if self.gains is not None else []
+
+    def _profile(self, x: np.ndarray) -> np.ndarray:
+        """Row-band then column-band sums of the measured pixels (colours summed)."""
+        rows = x.sum(axis=(0, 3, 4)).reshape(-1)
+        cols = x.sum(axis=(0, 1, 2)).reshape(-1)
+        off = float(self._offset.sum())
+        return np.concatenate([np.bincount(self.row_band, rows, self._nr) + off * self._row_px,
+                               np.bincount(self.col_band, cols, self._nc) + off * self._col_px])
+
+    def _release(self, ready) -> None:
+        lat = self.lattice
+        for _, g in ready:
+            x = self._waiting.popleft()
+            if np.any(g):
+                per_row = (1.0 + g[:self._nr])[self.row_band].reshape(lat.nty, lat.th).astype(np.float32)
+                off = self._offset[:, None, None, None, None]
+                x += off
+                x /= per_row[None, :, :, None, None]
+                x -= off
+            self._add(x)
+
     def update(self, planes) -> None:
-        if self.frames == 0:
+        if not self._ready:
             self._setup(planes)
-            x = self._rgb(planes)
+            self._ready = True
+        x = self._rgb(planes)
+        if self.gains is None:
+            self._add(x)
+            return
+        self._waiting.append(x)
+        self._release(self.gains.push(self._profile(x)))
+
+    def finish(self) -> None:
+        """Hand every frame still waiting for its gain to the sums (at the end of the video)."""
+        if self.gains is not None and self._waiting is not None:
+            self._release(self.gains.flush())
+
+    def _add(self, x: np.ndarray) -> None:
+        if self.frames == 0:
             self.first = x
             self.prev = x
             # float32 sums over a chunk of frames (same-type adds cost about half of float32 ->
@@ -270,7 +340,6 @@ class SnrAccumulator:
             self._pending = 0
             self.frames = 1
             return
-        x = self._rgb(planes)
         c = np.subtract(x, self.first)
         d = np.subtract(x, self.prev)
         self.prev = x
@@ -301,6 +370,7 @@ class SnrAccumulator:
         self._pending = 0
 
     def result(self) -> SnrResult:
+        self.finish()
         if self.frames < MIN_FRAMES:
             raise WallcliError(f"only {self.frames} frame(s) decoded; the noise estimate needs at least "
                                f"{MIN_FRAMES} (it compares consecutive frames, over time)")
@@ -321,8 +391,12 @@ class FrameSnr:
     the space-time plots check theirs): a tap for :class:`wallcli.io.video.FrameTee`, so the SNR
     of a clip comes out of a decode that also feeds something else."""
 
-    def __init__(self, roi: Roi | None = None, *, max_pixels: int = DEFAULT_MAX_PIXELS):
+    wants_fps = True  # classify_video tells it the video's frame rate (for the corrections)
+
+    def __init__(self, roi: Roi | None = None, *, max_pixels: int = DEFAULT_MAX_PIXELS, corrections=None,
+                 fps: float | None = None):
         self.requested, self.max_pixels = roi, int(max_pixels)
+        self.corrections, self.fps = corrections, fps
         self.acc: SnrAccumulator | None = None
 
     def __call__(self, frame) -> None:
@@ -331,7 +405,7 @@ class FrameSnr:
             from wallcli.signal.blocks import check_roi
 
             roi = check_roi(self.requested, planes.width, planes.height)
-            self.acc = SnrAccumulator(roi, max_pixels=self.max_pixels)
+            self.acc = SnrAccumulator(roi, max_pixels=self.max_pixels, corrections=self.corrections, fps=self.fps)
         self.acc.update(planes)
 
     def result(self) -> SnrResult:
@@ -347,6 +421,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
     decode that also makes the space-time plots), so both report the same fields.  ``notes``:
     the reader's warnings, listed before the estimator's own.
     """
+    acc.finish()
     if acc.frames < MIN_FRAMES:
         raise WallcliError(f"{source}: only {acc.frames} frame(s) decoded; the noise estimate needs at least "
                            f"{MIN_FRAMES} (it compares consecutive frames over time)")
@@ -367,6 +442,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
         "sampled_pixels": res.sampled_pixels,
         "exact": res.exact,
         "warnings": [*notes, *res.warnings],
+        "corrections": acc.corrections,
     }
 
 

@@ -44,6 +44,7 @@ class CameraParams:
     drift: float = 0.0  # relative amplitude of slow light drift
     flicker: float = 0.0  # relative amplitude of mains flicker (aliased to the frame rate)
     mains: float = 50.0
+    rolling_shutter: float = 0.0  # readout time / frame interval: flicker as bands moving down the frame (0: global)
     ae_steps: int = 0
     ae_size: float = 0.02
     shake: float = 0.0  # rms sub-pixel shake (pixels)
@@ -214,6 +215,7 @@ class Camera:
         var = (np.clip(self.static, 0, None) * p.gain + p.read_noise**2) / ratio
         self.sigma = (np.maximum(np.sqrt(var) * p.noise_scale, NOISE_FLOOR)).astype(np.float32)  # (H, 3, W)
         self.rng = rng
+        self.row_gains = None  # (frames, H) flicker of a rolling shutter, else None
         self.gains, self.shifts = self._tracks(frames, rng)
 
     def upsample(self, E: np.ndarray) -> np.ndarray:
@@ -234,7 +236,15 @@ class Camera:
         if p.flicker:
             f = 2 * p.mains
             alias = f - p.fps * np.round(f / p.fps)
-            g *= 1 + p.flicker * np.sin(2 * np.pi * alias * t + rng.uniform(0, 6.3))
+            phase = 2 * np.pi * alias * t + rng.uniform(0, 6.3)
+            if p.rolling_shutter:
+                # row y is read rolling_shutter * y / H frame intervals after the first: the lamp's
+                # phase (at its true 2 f_mains) advances down the frame, and at the frame times the
+                # bands move at the alias frequency
+                rows = 2 * np.pi * f * (p.rolling_shutter / p.fps) * (np.arange(p.height) + 0.5) / p.height
+                self.row_gains = (1 + p.flicker * np.sin(phase[:, None] + rows[None, :])).astype(np.float32)
+            else:
+                g *= 1 + p.flicker * np.sin(phase)
         for _ in range(p.ae_steps):
             at = rng.uniform(0.1, 0.9) * dur
             ramp = np.clip((t - at) / rng.uniform(0.05, 0.3), 0, 1)
@@ -265,6 +275,8 @@ class Camera:
         noise = self.rng.standard_normal(lin.shape, dtype=np.float32)
         noise *= self.sigma
         lin *= np.float32(self.gains[index] * self.LUT_STEP)
+        if self.row_gains is not None:
+            lin *= self.row_gains[index][:, None, None]
         lin += noise * np.float32(self.LUT_STEP)
         lin += np.float32(0.5)
         np.clip(lin, 0, len(self.lut) - 1, out=lin)

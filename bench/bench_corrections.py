@@ -1,0 +1,133 @@
+"""What each correction of issue 27 (aliased mains flicker, exposure steps and drift) costs in
+throughput: each command with each correction on, against the same command with both off, in
+one run.
+
+    .venv/bin/python bench/bench_corrections.py [--frames 600] [--repeat 3]
+
+Clips: the 1080p30 bench clip (bench/clips.py) and the same wall at 320x240. Every job runs in a
+fresh process (bench/measure.py); the variants of a command alternate within each repeat and
+the fastest run of each counts. Ratios are throughput (frames/s) over that of the same command
+with ``--no-deflicker --no-exposure``; CPU-time ratios move least when other work loads the
+machine. Whole commands are timed, start-up included.
+
+``--micro`` times the corrections' own work in this process, which a busy machine blurs less:
+per 256-sample window of the classifiers (both plots, 64 bins) against the rest of the window's
+work (normalisation and the model), and per 1080p frame of the SNR estimator against its own
+work per frame without them. The least CPU time of many repeats counts.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from bench_speed import measure  # noqa: E402
+from clips import OUT, clip_1080p, make_clip  # noqa: E402
+
+VARIANTS = {  # name: extra options
+    "off": ("--no-deflicker", "--no-exposure"),
+    "deflicker": ("--no-exposure",),
+    "exposure": ("--no-deflicker",),
+    "both (default)": (),
+}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--frames", type=int, default=600)
+    ap.add_argument("--repeat", type=int, default=3, help="runs per measurement; the fastest counts")
+    ap.add_argument("--commands", default="count,activity,snr")
+    ap.add_argument("--micro", action="store_true", help="time the corrections' own work instead (see above)")
+    args = ap.parse_args()
+    if args.micro:
+        return micro(clip_1080p(args.frames))
+    small = OUT / f"wall320_{args.frames}.mp4"
+    if not small.exists():
+        make_clip(small, args.frames, 320, 240)
+    clips = {"1080p": clip_1080p(args.frames), "320x240": small}
+    print(f"load average at start: {os.getloadavg()[0]:.1f}")
+    print("| clip | command | correction | frames/s | ratio to off (wall) | ratio to off (CPU) |")
+    print("|---|---|---|---|---|---|")
+    for label, clip in clips.items():
+        for cmd in args.commands.split(","):
+            runs: dict[str, list[dict]] = {v: [] for v in VARIANTS}
+            for _ in range(args.repeat):
+                for v, extra in VARIANTS.items():
+                    runs[v].append(measure("wallcli", cmd, str(clip), "--json", *extra))
+            best = {v: min(r, key=lambda x: x["seconds"]) for v, r in runs.items()}
+            cpu = {v: min(x["cpu_seconds"] for x in r) for v, r in runs.items()}
+            for v in VARIANTS:
+                fps = args.frames / best[v]["seconds"]
+                print(f"| {label} | {cmd} | {v} | {fps:.0f} | {best['off']['seconds'] / best[v]['seconds']:.2f} | "
+                      f"{cpu['off'] / cpu[v]:.2f} |", flush=True)
+    print(f"load average at end: {os.getloadavg()[0]:.1f}")
+
+
+def _best(fn, repeat: int = 30) -> float:
+    """The least CPU time (this process, all threads) of ``repeat`` calls: other processes on a
+    busy machine lengthen wall time far more."""
+    import time
+
+    out = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        out.append(time.process_time() - t0)
+    return min(out)
+
+
+def micro(clip: Path) -> None:
+    import numpy as np
+
+    from wallcli.infer.classify import _predict_window
+    from wallcli.infer.model import load_model
+    from wallcli.infer.stream import RowStream
+    from wallcli.io.video import open_video
+    from wallcli.signal import corrections as corr
+    from wallcli.signal.blocks import check_roi
+    from wallcli.signal.snr import SnrAccumulator
+
+    models = {t: load_model(t, None) for t in ("count", "activity")}
+    with open_video(str(clip)) as reader:
+        rows = RowStream(reader, bins=64, fps=30.0, vertical=True)
+        got = [r for _, r in zip(range(256), rows)]
+        ref = rows.ref
+    win = np.stack([r for _, r in got], axis=1)  # (2 bins, 256, 3)
+    # a 1 % flicker line, so that deflicker has its fit to do
+    t = np.arange(256) / 30.0
+    win = ((win + ref[:, None]) * (1 + 0.01 * np.sin(2 * np.pi * 10 * t))[None, :, None] - ref[:, None]).astype(np.float32)
+    print("| CPU per window (256 samples; one every 64 frames) | off | deflicker | exposure | both | ratio, both |")
+    print("|---|---|---|---|---|---|")
+    for task, model in models.items():
+        ms = {name: 1e3 * _best(lambda o=o: _predict_window(model, win, ref, native=30.0, options=o))
+              for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False)),
+                              ("exposure", corr.Options(False, True)), ("both", corr.Options()))}
+        print(f"| {task} | {ms['off']:.1f} ms | {ms['deflicker']:.1f} ms | {ms['exposure']:.1f} ms | {ms['both']:.1f} ms "
+              f"| {ms['off'] / ms['both']:.2f} |")
+    n = 160
+    with open_video(str(clip)) as reader:
+        frames = []
+        for f, _ in zip(reader.frames(), range(n)):
+            p = f.planes
+            frames.append(type(p)(p.y.copy(), None if p.u is None else p.u.copy(), None if p.v is None else p.v.copy(),
+                                  **{k: getattr(p, k) for k in ("kind", "sub_x", "sub_y", "depth", "matrix", "full_range")}))
+    roi = check_roi(None, frames[0].width, frames[0].height)
+
+    def snr(o):
+        acc = SnrAccumulator(roi, corrections=o, fps=30.0)
+        for p in frames:
+            acc.update(p)
+        acc.result()
+
+    ms = {name: 1e3 * _best(lambda o=o: snr(o), 5) / n for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False)),
+                                                                        ("exposure", corr.Options(False, True)), ("both", corr.Options()))}
+    print(f"| snr, per 1080p frame | {ms['off']:.2f} ms | {ms['deflicker']:.2f} ms | {ms['exposure']:.2f} ms | "
+          f"{ms['both']:.2f} ms | {ms['off'] / ms['both']:.2f} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,508 @@
+"""Whole-frame light nuisances found and removed before analysis: aliased mains flicker (whole-frame
+and rolling-shutter bands) and auto-exposure steps and slow drift.
+
+Works on the raw per-frame profiles of the ROI (the space-time plots' rows, or any per-frame
+profile such as the SNR estimator's row means), never on pixels, one stretch of frames at a time
+(a 256-sample window of the classifiers, or a block of the SNR estimator's frames): memory is
+bounded and ``--follow`` still works.
+
+What a nuisance is, and what a person is. A person changes the wall by 0.1-1 % unevenly along
+it and not periodically. The nuisances here are whole-frame and multiplicative, and each has a
+shape a person does not make:
+
+- **flicker**: lamps on mains power flicker at twice the mains frequency (100 or 120 Hz); a
+  camera samples that at its frame rate, so the video carries a *narrow line* at the alias
+  frequency |2 f_mains - k fps| (10 Hz for 50 Hz mains at 30 fps, 5 Hz at 25 fps with 60 Hz
+  mains). Only those predicted frequencies (within ``SEARCH_HZ``) are searched, and a line is
+  removed only when its power summed over the bins stands ``LINE_RATIO`` times above its
+  neighbourhood of the spectrum. Each bin's own sinusoid at that frequency is removed, so the
+  rolling-shutter form (bands whose phase advances down the frame, the vertical bins' phases
+  differing) goes as completely as the whole-frame one; a person loses one frequency bin out of
+  128 at most.
+- **exposure**: the whole frame's gain, robustly (the median over the bins of each bin's
+  relative change, so that a shadow over part of the wall does not move it): steps (jumps of at
+  least ``STEP_MIN`` and ``STEP_SIGMA`` times the gain's frame noise, within ``RAMP_S`` seconds:
+  beyond what a hidden person does to the whole wall in a few frames) and drift (a cubic over
+  the stretch, slower than about one cycle in 8 s; removed only when it exceeds ``DRIFT_MIN``
+  peak to peak).
+
+``correct`` divides the found gains out and returns what was found; ``merge`` sums a clip's
+findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
+``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``).
+A slot for camera shake (``kind: "shake"``) belongs beside these, before the block sums.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+MAINS_HZ = (50.0, 60.0)
+MIN_LINE_HZ = 0.5  # slower aliases are drift's business
+SEARCH_HZ = 0.3  # mains and camera clocks wander: search this far around each predicted alias
+LINE_RATIO = 25.0  # line power over the median of its +-3 Hz neighbourhood
+STEP_MIN = 0.003  # relative size of the smallest exposure step removed
+STEP_SIGMA = 10.0  # and in units of the gain's frame-to-frame noise
+RAMP_S = 0.33  # seconds an exposure step may take
+SPAN_S = 0.5  # seconds averaged on each side of a step
+MAX_STEPS = 4
+DRIFT_DEGREE = 3
+DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
+DRIFT_AGREE = True  # drift only where most bins drifted alike
+MIN_SAMPLES = 64  # shorter stretches are left alone
+UNEVEN = 0.2  # a bin's change within this fraction of the common one (plus its noise) is alike
+UNEVEN_DRIFT = 0.4  # the same for drift: a passing shadow bends a bin's slow curve (a cubic) a little
+AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change alike for a step or drift
+AGREE_EACH = 0.5  # and in each profile
+
+
+@dataclass(frozen=True)
+class Options:
+    deflicker: bool = True
+    exposure: bool = True
+
+    @property
+    def any(self) -> bool:
+        return self.deflicker or self.exposure
+
+
+OFF = Options(False, False)
+
+
+def fold(f: float, rate: float) -> float:
+    """The frequency a sinusoid of ``f`` Hz shows when sampled at ``rate`` Hz (in [0, rate/2])."""
+    x = float(f) % float(rate)
+    return min(x, rate - x)
+
+
+def mains_lines(native_fps: float | None, rate: float) -> list[float]:
+    """Where aliased mains flicker can show in a series at ``rate`` made from video at
+    ``native_fps`` (twice the mains frequency, folded by the camera, then by any resampling)."""
+    fps = float(native_fps) if native_fps and native_fps > 0 else float(rate)
+    out = []
+    for mains in MAINS_HZ:
+        f = fold(fold(2 * mains, fps), rate)
+        if f >= MIN_LINE_HZ and f < rate / 2 - SEARCH_HZ and all(abs(f - g) > 2 * SEARCH_HZ for g in out):
+            out.append(f)
+    return out
+
+
+def _solve(design: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Least squares for a few columns and many right-hand sides: the pseudo-inverse of the small
+    design once, then one product (numpy's lstsq of 128 series took 50 ms a window)."""
+    return np.linalg.pinv(design) @ y
+
+
+# ------------------------------------------------------------------------------------ flicker
+def _find_line(rel: np.ndarray, rate: float, lines) -> tuple[float, float] | None:
+    """(frequency, line ratio) of the strongest aliased mains line in ``rel`` (T, K) (relative
+    changes, K series), or None."""
+    t = rel.shape[0]
+    pad = 8 * t
+    win = np.hanning(t)[:, None]
+    spec = np.abs(np.fft.rfft((rel - rel.mean(axis=0)) * win, n=pad, axis=0)) ** 2
+    power = spec.sum(axis=1)
+    freqs = np.fft.rfftfreq(pad, 1.0 / rate)
+    best = None
+    for f0 in lines:
+        near = np.abs(freqs - f0) <= SEARCH_HZ
+        around = (np.abs(freqs - f0) <= 3.0) & ~(np.abs(freqs - f0) <= SEARCH_HZ + 4.0 * rate / t) & (freqs >= MIN_LINE_HZ)
+        if not near.any() or around.sum() < 8:
+            continue
+        i = int(np.flatnonzero(near)[np.argmax(power[near])])
+        ratio = float(power[i] / max(np.median(power[around]), 1e-300))
+        if ratio < LINE_RATIO:
+            continue
+        f = freqs[i]
+        if 0 < i < len(power) - 1:  # parabolic interpolation of the log peak
+            a, b, c = np.log(power[i - 1:i + 2] + 1e-300)
+            den = a - 2 * b + c
+            if den < 0:
+                f += 0.5 * (a - c) / den * (freqs[1] - freqs[0])
+        if best is None or ratio > best[1]:
+            best = (float(f), ratio)
+    return best
+
+
+def _sinusoids(rel: np.ndarray, f: float, rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares (cos, sin) amplitudes of ``f`` in each column of ``rel`` (T, K), fitted with a
+    constant and a slope beside them; returns (basis (T, 2), coefficients (2, K))."""
+    t = np.arange(rel.shape[0]) / rate
+    ph = 2 * np.pi * f * t
+    tt = (t - t.mean()) / max(t.std(), 1e-9)
+    design = np.stack([np.cos(ph), np.sin(ph), np.ones_like(t), tt], axis=1)
+    coef = _solve(design, rel)
+    return design[:, :2], coef[:2]
+
+
+# ------------------------------------------------------------------------------------ exposure
+def _robust_gain(rel: np.ndarray) -> np.ndarray:
+    """The whole frame's relative gain per sample: the median over the series of (T, K)."""
+    return np.median(rel, axis=1)
+
+
+def _legendre(t: int, degree: int) -> np.ndarray:
+    x = np.linspace(-1.0, 1.0, t)
+    return np.polynomial.legendre.legvander(x, degree)
+
+
+def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None,
+           uneven: float = None) -> bool:
+    """Whether a change (per_bin (K, ...)) is the light's: in every profile (``part`` (K,) says
+    which bin is whose) at least ``AGREE_EACH`` and on average ``AGREE`` of the bins that can tell
+    (their noise ``tol`` (K,) under half the change) changed as the common one (...), within
+    ``UNEVEN`` of it plus their noise. A change of the light multiplies every bin alike; a person's
+    shadow does not, though it can dim all the rows (or all the columns) of a wall alike."""
+    uneven = UNEVEN if uneven is None else uneven
+    part = np.zeros(per_bin.shape[0], int) if part is None else np.asarray(part)
+    size = float(np.sqrt(np.mean(np.square(common))))
+    dev = np.sqrt(np.mean(np.square(per_bin - common[None]).reshape(per_bin.shape[0], -1), axis=1))
+    fractions = []
+    for p in np.unique(part):
+        mine = part == p
+        tells = mine & (tol < 0.5 * size)
+        if tells.sum() < max(4, 0.5 * mine.sum()):
+            return False  # too noisy to tell a light's change from a person's
+        fractions.append(float(np.mean(dev[tells] <= uneven * size + tol[tells])))
+    return min(fractions) >= AGREE_EACH and float(np.mean(fractions)) >= AGREE
+
+
+def _local_steps(rel: np.ndarray, j: int, half: int, span: int) -> np.ndarray:
+    """Each series' step at ``j``: a level, a slope and a step fitted to the ``span`` samples on
+    either side of the ramp (the slope takes up a person's slower change across it)."""
+    t = rel.shape[0]
+    idx = np.r_[max(j - half - span, 0):max(j - half, 0), min(j + half, t):min(j + half + span, t)]
+    x = (idx - j) / max(span, 1)
+    design = np.stack([np.ones_like(x), x, (idx >= j).astype(np.float64)], axis=1)
+    coef = _solve(design, rel[idx])
+    return coef[2]
+
+
+def _rise(g: np.ndarray, j: int, half: int, span: int) -> int:
+    """Samples the change of ``g`` around ``j`` takes from 10 % to 90 % of the way between the
+    means of the ``span`` samples before and after it (a light's step is quick; the whole wall
+    dims or brightens as a person moves in front of a lamp over half a second or more)."""
+    t = g.size
+    lo, hi = max(j - half - span, 0), min(j + half + span, t)
+    before = g[lo:max(j - half, lo + 1)].mean()
+    after = g[min(j + half, hi - 1):hi].mean()
+    if after == before:
+        return t
+    k = np.convolve(g[lo:hi], np.ones(3) / 3, mode="same")
+    f = (k - before) / (after - before)
+    seg = f[1:-1]
+    above = np.flatnonzero(seg >= 0.9)
+    if above.size == 0:
+        return t
+    end = int(above[0])
+    below = np.flatnonzero(seg[:end] <= 0.1)
+    start = int(below[-1]) if below.size else 0
+    return end - start
+
+
+def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
+    """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
+    changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins. Steps
+    are found greedily where the means of the ``SPAN_S`` seconds on either side of a ``RAMP_S``
+    differ by more than STEP_MIN and STEP_SIGMA noise, and kept only where most bins stepped alike
+    (``AGREE``) in every profile (``part`` (K,): which profile each bin is of; a person's shadow
+    can dim all the rows of a wall alike, not also all its columns); so is the drift."""
+    t = rel.shape[0]
+    g = _robust_gain(rel)
+    basis = _legendre(t, DRIFT_DEGREE)
+    dg = np.diff(g)
+    noise = 1.4826 * np.median(np.abs(dg - np.median(dg))) / np.sqrt(2.0)
+    db = np.diff(rel, axis=0)
+    sigma = 1.4826 * np.median(np.abs(db - np.median(db, axis=0)), axis=0) / np.sqrt(2.0)  # (K,) per bin
+    found: list[int] = []
+    sizes: list[float] = []  # each step's size: the median of the bins' own (a shadow moves the joint fit's)
+    blocked: list[int] = []
+    cols = [basis]
+    ramp = max(2, int(round(RAMP_S * rate)))
+    span = max(4, int(round(SPAN_S * rate)))
+    half = ramp // 2
+    for _ in range(2 * MAX_STEPS):
+        if len(found) >= MAX_STEPS:
+            break
+        design = np.concatenate(cols, axis=1)
+        coef = _solve(design, g)
+        r = g - design @ coef
+        c = np.concatenate([[0.0], np.cumsum(r)])
+        idx = np.arange(span + half, t - span - half)
+        if idx.size == 0:
+            break
+        after = (c[idx + half + span] - c[idx + half]) / span
+        before = (c[idx - half] - c[idx - half - span]) / span
+        d = after - before
+        for j in found + blocked:  # one step is looked at once
+            d[np.abs(idx - j) < ramp + span] = 0.0
+        k = int(np.argmax(np.abs(d)))
+        if abs(d[k]) < max(STEP_MIN, STEP_SIGMA * noise):
+            break
+        # the plateau of d is a ramp wide: the step is where the adjacent means differ most
+        cand = np.arange(max(int(idx[k]) - half, span), min(int(idx[k]) + half + 1, t - span + 1))
+        j = int(idx[k])
+        if cand.size:
+            adj = (c[cand + span] - c[cand]) - (c[cand] - c[cand - span])
+            j = int(cand[np.argmax(np.abs(adj))])
+        per_bin = _local_steps(rel, j, half, span)
+        common = np.array([np.median(per_bin)])
+        tol = 4 * sigma * np.sqrt(2.0 / span)
+        if (abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _rise(g, j, half, span) <= ramp + 3
+                and _agree(per_bin[:, None], common, tol, part)):
+            found.append(j)
+            sizes.append(float(common[0]))
+            cols.append((np.arange(t) >= j).astype(np.float64)[:, None])
+        else:
+            blocked.append(j)  # uneven along the wall: someone's shadow, kept
+    stepped = sum((size * (np.arange(t) >= j) for j, size in zip(found, sizes)), np.zeros(t))
+    nb = basis.shape[1]
+    coef = _solve(basis, g - stepped)
+    drift = basis[:, 1:] @ coef[1:]
+    ptp = float(drift.max() - drift.min())
+    if ptp >= DRIFT_MIN:
+        cb = _solve(basis, rel - stepped[:, None])
+        per_bin = (basis[:, 1:] @ cb[1:nb]).T  # (K, T)
+        tol = 3 * sigma * np.sqrt((nb - 1) / t)
+        if DRIFT_AGREE and not _agree(per_bin, drift, tol, part, UNEVEN_DRIFT):
+            ptp = 0.0
+    model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
+    steps = []
+    for j, size in zip(found, sizes):
+        model = model + size * (np.arange(t) >= j)
+        steps.append((j, float(size)))
+    for j, _ in steps:  # within a ramp the step's shape is what was measured, not a jump
+        lo, hi = max(j - half - 1, 0), min(j + half + 1, t)
+        model[lo:hi] = g[lo:hi] - np.median((g - model)[max(lo - span, 0):min(hi + span, t)])
+    return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
+
+
+# ------------------------------------------------------------------------------------ the fit
+@dataclass
+class Fit:
+    """Relative gains found on one stretch: multiply the raw levels by 1 / (1 + gain)."""
+
+    gain: np.ndarray  # (T, K) per sample and series
+    findings: list[dict[str, Any]]
+
+
+def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options(), t0: float = 0.0,
+        vertical: slice | None = None, part=None) -> Fit | None:
+    """The nuisances of a stretch of raw levels (T, K) (K series: profile bins, colours summed or
+    not; all positive levels of the same frames) sampled at ``rate``. ``lines``: the frequencies
+    where aliased mains flicker may show (:func:`mains_lines`). ``vertical``: which series are
+    the vertical profile (in order down the frame), for telling rolling-shutter bands; ``part``
+    (K,) which profile each series belongs to (a change of the light is alike along each).
+    None when nothing was found."""
+    levels = np.asarray(levels, np.float64)
+    t = levels.shape[0]
+    if t < MIN_SAMPLES or not options.any:
+        return None
+    mean = levels.mean(axis=0)
+    ok = mean > 1e-6 * max(float(np.abs(mean).max()), 1e-12)
+    if not ok.any():
+        return None
+    rel = np.zeros_like(levels)
+    rel[:, ok] = levels[:, ok] / mean[ok] - 1.0
+    gain = np.zeros_like(rel)
+    findings = []
+    if options.deflicker and lines:
+        line = _find_line(rel[:, ok], rate, lines)
+        if line is not None:
+            f, ratio = line
+            basis, coef = _sinusoids(rel, f, rate)
+            wave = basis @ coef
+            wave[:, ~ok] = 0.0
+            gain += wave
+            rel = (1.0 + rel) / (1.0 + wave) - 1.0
+            amp = np.hypot(coef[0], coef[1])[ok]
+            found = {"kind": "flicker", "hz": round(float(f), 3), "amplitude": float(np.median(amp)),
+                     "line_ratio": float(ratio)}
+            if vertical is not None:
+                v = np.arange(levels.shape[1])[vertical]
+                v = v[ok[v]]
+                if v.size >= 4:
+                    ph = np.unwrap(np.arctan2(coef[1, v], coef[0, v]))
+                    turn = float(abs(ph[-1] - ph[0]) / (2 * np.pi))
+                    found["rolling_shutter"] = turn >= 0.25
+                    found["bands"] = round(turn, 2)  # cycles of the bands over the profile's height
+            findings.append(found)
+    if options.exposure:
+        model, steps, drift = _steps_and_drift(rel[:, ok], rate, None if part is None else np.asarray(part)[ok])
+        model = model - np.mean(model)
+        if steps or drift:
+            gain = (1.0 + gain) * (1.0 + model[:, None]) - 1.0
+            if steps:
+                findings.append({"kind": "exposure", "steps": [{"time": round(t0 + j / rate, 3), "size": round(s, 5)}
+                                                               for j, s in steps]})
+            if drift:
+                findings.append({"kind": "drift", "amplitude": round(drift / 2, 5)})
+    if not findings:
+        return None
+    return Fit(gain, findings)
+
+
+# ------------------------------------------------------------------------------------ windows
+def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: float, *, lines=(),
+                    options: Options = Options(), starts=None, vertical_index: int | None = None):
+    """Correct plot windows in place of the classifiers' path.
+
+    ``parts``: [(n, bins, T, 3) windows relative to ``offsets`` [(n or 1, bins, 3)]] (e.g.
+    horizontal and vertical); all parts of a window are fitted together (a part that is all zero,
+    such as a vertical plot not computed, is left out). Returns (corrected parts (float32),
+    [findings per window]).
+    """
+    n = parts[0].shape[0]
+    out = [np.array(p, np.float32, copy=True) for p in parts]
+    found = [[] for _ in range(n)]
+    if not options.any:
+        return out, found
+    for w in range(n):
+        raws, used = [], []
+        for k, (p, off) in enumerate(zip(parts, offsets)):
+            x = p[w].astype(np.float64)
+            if not np.any(x):
+                continue
+            o = np.asarray(off, np.float64)
+            raw = x + o[min(w, o.shape[0] - 1)][:, None, :]  # (bins, T, 3)
+            raws.append(raw)
+            used.append(k)
+        if not raws:
+            continue
+        # colours summed: the nuisances are grey; (T, K) with K the bins of every part used
+        series = np.concatenate([r.sum(axis=-1).T for r in raws], axis=1)
+        vs = None
+        if vertical_index is not None and vertical_index in used:
+            start = sum(raws[i].shape[0] for i in range(used.index(vertical_index)))
+            vs = slice(start, start + raws[used.index(vertical_index)].shape[0])
+        t0 = 0.0 if starts is None else float(starts[w])
+        part = np.concatenate([np.full(r.shape[0], i) for i, r in enumerate(raws)])
+        res = fit(series, rate, lines=lines, options=options, t0=t0, vertical=vs, part=part)
+        if res is None:
+            continue
+        pos = 0
+        for k, raw in zip(used, raws):
+            b = raw.shape[0]
+            g = res.gain[:, pos:pos + b].T[:, :, None]  # (bins, T, 1)
+            pos += b
+            o = np.asarray(offsets[k], np.float64)[min(w, np.asarray(offsets[k]).shape[0] - 1)][:, None, :]
+            out[k][w] = (raw / (1.0 + g) - o).astype(np.float32)
+        found[w] = res.findings
+    return out, found
+
+
+def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
+    """A clip's ``corrections``: what its windows (or blocks) found, one entry per kind.
+
+    flicker: the median frequency and amplitude over the windows where it was found, and in how
+    many; exposure: every step once (windows overlap: steps within 1 s are one); drift: the
+    largest amplitude."""
+    flick = [f for fs in per_window for f in fs if f["kind"] == "flicker"]
+    out: list[dict[str, Any]] = []
+    if flick:
+        e = {"kind": "flicker", "hz": round(float(np.median([f["hz"] for f in flick])), 3),
+             "amplitude": round(float(np.median([f["amplitude"] for f in flick])), 6),
+             "windows": len(flick)}
+        rs = [f["rolling_shutter"] for f in flick if "rolling_shutter" in f]
+        if rs:
+            e["rolling_shutter"] = sum(rs) * 2 > len(rs)
+            e["bands"] = round(float(np.median([f["bands"] for f in flick if "bands" in f])), 2)
+        out.append(e)
+    steps = sorted((s for fs in per_window for f in fs if f["kind"] == "exposure" for s in f["steps"]),
+                   key=lambda s: s["time"])
+    if steps:
+        kept: list[list[dict]] = []
+        for s in steps:
+            if kept and s["time"] - kept[-1][-1]["time"] < 1.0:
+                kept[-1].append(s)
+            else:
+                kept.append([s])
+        out.append({"kind": "exposure", "steps": [
+            {"time": round(float(np.median([s["time"] for s in g])), 3),
+             "size": round(float(np.median([s["size"] for s in g])), 5)} for g in kept]})
+    drift = [f["amplitude"] for fs in per_window for f in fs if f["kind"] == "drift"]
+    if drift:
+        out.append({"kind": "drift", "amplitude": round(float(max(drift)), 5), "windows": len(drift)})
+    return out
+
+
+# ------------------------------------------------------------------------------------ streams
+class LaggedGains:
+    """:func:`fit` in a bounded running form, for consumers of whole frames (the SNR estimator):
+    push one profile (K,) per frame; get back (frame index, gain (K,)) for earlier frames.
+
+    Every ``hop`` frames the last ``window`` profiles are fitted and the gains of their middle
+    part are final (the first fit's also from frame 0, :meth:`flush` the rest), so each frame's
+    gain comes from a fit that saw ``(window - hop) / 2`` frames on either side of it; the lag
+    is under ``window`` frames (``hop + (window - hop) / 2`` after the first fit), the memory
+    ``window`` profiles.
+    """
+
+    def __init__(self, rate: float, *, lines=(), options: Options = Options(), window: int = 256,
+                 hop: int = 64, vertical: slice | None = None):
+        from collections import deque
+
+        self.rate, self.lines, self.options = float(rate), list(lines), options
+        self.window, self.hop, self.vertical = int(window), int(hop), vertical
+        self.margin = (self.window - self.hop) // 2
+        self._buf: deque = deque(maxlen=self.window)
+        self.count = 0  # frames pushed
+        self.done = 0  # frames whose gain was handed out
+        self.found: list[list[dict]] = []
+        self._flushed = False
+        self._prev: tuple[int, np.ndarray] | None = None  # the last fit: (first frame, gains)
+
+    def _fit(self, upto: int) -> list[tuple[int, np.ndarray]]:
+        levels = np.stack(self._buf)
+        first = self.count - levels.shape[0]
+        part = None
+        if self.vertical is not None:
+            part = np.ones(levels.shape[1], int)
+            part[self.vertical] = 0
+        res = fit(levels, self.rate, lines=self.lines, options=self.options, t0=first / self.rate,
+                  vertical=self.vertical, part=part)
+        if res is not None:
+            self.found.append(res.findings)
+        gains = res.gain if res is not None else np.zeros_like(levels)
+        # each fit's gains are relative to its own stretch's mean level; carry the previous fit's
+        # level over their overlap, or a step would reappear at every hop (its size times the
+        # change of the stretch's mean)
+        if self._prev is not None:
+            p0, prev = self._prev
+            lo, hi = max(first, p0), min(first + len(gains), p0 + len(prev))
+            if hi > lo:
+                factor = float(np.median((1.0 + prev[lo - p0:hi - p0]) / (1.0 + gains[lo - first:hi - first])))
+                gains = (1.0 + gains) * factor - 1.0
+        self._prev = (first, gains)
+        out = [(i, gains[i - first]) for i in range(self.done, upto)]
+        self.done = upto
+        return out
+
+    def push(self, profile: np.ndarray) -> list[tuple[int, np.ndarray]]:
+        self._buf.append(np.asarray(profile, np.float64))
+        self.count += 1
+        if self.count >= self.window and (self.count - self.window) % self.hop == 0:
+            return self._fit(self.count - self.margin)
+        return []
+
+    def flush(self) -> list[tuple[int, np.ndarray]]:
+        """The gains of every frame not handed out yet (once)."""
+        if self._flushed or self.done >= self.count:
+            self._flushed = True
+            return []
+        self._flushed = True
+        if self.count < MIN_SAMPLES:
+            out = [(i, np.zeros(len(self._buf[0]))) for i in range(self.done, self.count)]
+            self.done = self.count
+            return out
+        return self._fit(self.count)
+
+    def corrections(self) -> list[dict[str, Any]]:
+        return merge(self.found)
+
+
+def bands(n: int, most: int = 64) -> np.ndarray:
+    """For ``n`` consecutive lines, the band (0..) each falls in, at most ``most`` bands."""
+    k = min(n, most)
+    return (np.arange(n) * k) // max(n, 1)
