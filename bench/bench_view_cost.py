@@ -38,11 +38,12 @@ main()
 """
 
 
-def _once(side: str, args: list[str]) -> tuple[float, float]:
-    """(wall seconds, CPU seconds) of one whole command."""
+def _once(side: str, args: list[str], tree: str | None = None) -> tuple[float, float]:
+    """(wall seconds, CPU seconds) of one whole command; ``tree``: run that source tree instead."""
+    env = dict(os.environ, PYTHONPATH=tree) if tree else None
     c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", _RUN, side, *args], capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-c", _RUN, side, *args], capture_output=True, text=True, env=env)
     seconds = time.perf_counter() - t0
     c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if out.returncode:
@@ -55,21 +56,39 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=600)
     ap.add_argument("--pairs", type=int, default=5)
     ap.add_argument("--command", default="count", choices=["count", "activity", "snr"])
+    ap.add_argument("--baseline", metavar="COMMIT",
+                    help="the 'without' side is this commit of the repository as it was (exported to a temporary "
+                         "folder), run whole, instead of this tree with the check removed: e.g. the commit before "
+                         "issue 27 (dc8e913^1), for everything the issue added (view check and corrections)")
     a = ap.parse_args()
     clip = str(clip_1080p(a.frames))
     args = [a.command, clip, "--json"]
+    tree = None
+    if a.baseline:
+        import tarfile
+        import tempfile
+
+        tree = tempfile.mkdtemp(prefix="wallcli-baseline-")
+        archive = subprocess.run(["git", "-C", str(HERE.parent), "archive", a.baseline], capture_output=True, check=True)
+        import io
+        with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as t:
+            t.extractall(tree, filter="data")
+    side = "with" if tree else "without"
     _once("with", args)  # warm the page cache and Python's bytecode cache
+    if tree:
+        _once(side, args, tree)
     ratios, cpu = [], []
     for i in range(a.pairs):
-        without, without_cpu = _once("without", args)
+        without, without_cpu = _once(side, args, tree)
         with_, with_cpu = _once("with", args)
         ratios.append(without / with_)
         cpu.append(without_cpu / with_cpu)
         print(f"  pair {i + 1}: without {without:.2f} s ({without_cpu:.2f} CPU s), with {with_:.2f} s "
               f"({with_cpu:.2f} CPU s): {ratios[-1]:.2f} x", file=sys.stderr)
     load = os.getloadavg()[0]
+    what = f"the throughput of {a.baseline}" if a.baseline else "the throughput without it"
     print(f"{a.command} on 1080p30, {a.frames} frames: with the view check {statistics.median(ratios):.2f} x "
-          f"the throughput without it, {statistics.median(cpu):.2f} x in CPU time (medians of {a.pairs} pairs; "
+          f"{what}, {statistics.median(cpu):.2f} x in CPU time (medians of {a.pairs} pairs; "
           f"wall: {', '.join(f'{r:.2f}' for r in ratios)}); load average {load:.1f} on {os.cpu_count()} cores")
 
 
