@@ -252,11 +252,12 @@ class ViewCheck:
             cv2.setNumThreads(threads)
 
     def _watch_cut(self, t: float, planes) -> float | None:
-        """The time of the previous frame if it was a cut: much of the frame changed from the frame
-        before it, beyond a whole-frame gain (exposure, flicker), with calm frames on either side
-        (a hard shadow sweeping the wall changes as much, but over several frames). Judged on every
-        frame, one frame late, on block means of the luma sampled on a grid of at most MAX_SIDE
-        on the long side (a cut changes whole blocks; sampling costs a strided copy, not a resize)."""
+        """The time of the previous sample if it was a cut: much of the frame changed from the
+        sample before it, beyond a whole-frame gain (exposure, flicker), with calm samples on
+        either side (a hard shadow sweeping the wall changes as much, but over several frames).
+        Judged on CUT_RATE frames a second, one sample late, on block means of the luma sampled
+        at most CUT_SIDE pixels wide (a cut changes whole blocks: a gather of pixels, not a resize,
+        is enough to see it)."""
         import cv2
 
         y = _whole_blocks(_sampled_luma(planes, self.roi, CUT_SIDE))
