@@ -23,15 +23,9 @@ def _scene(seed: int, domain: str, seconds: float = SECONDS, **camera):
 
 
 def _encode(path, frames):
-    from wallcli.io.writer import VideoWriter
+    from wallcli.sim.views import encode
 
-    frames = iter(frames)
-    first = next(frames)
-    with VideoWriter(path, FPS, first.shape[1], first.shape[0], codec="libx264", crf=18) as vw:
-        vw.write(first)
-        for f in frames:
-            vw.write(f)
-    return path
+    return encode(frames, path, fps=FPS)
 
 
 def _check(path) -> dict:

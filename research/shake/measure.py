@@ -28,7 +28,7 @@ def _clip(seed: int, rms: float, features: float, path: Path) -> dict:
     from wallcli.sim.scene import SceneConfig, sample_scene
 
     rng = np.random.default_rng(seed)
-    from wallcli.io.writer import VideoWriter
+    from wallcli.sim.views import encode
 
     people = int(rng.integers(0, 3))
     acts = ["walking", "crouching", "waving", "jumping"]
@@ -38,9 +38,7 @@ def _clip(seed: int, rms: float, features: float, path: Path) -> dict:
                       camera_overrides={"shake": rms, "shake_exact": True, "features": features,
                                         "drift": 0.0, "flicker": 0.0, "ae_steps": 0})
     scene = sample_scene(seed, cfg)
-    with VideoWriter(path, 30.0, 320, 240, codec="libx264", crf=18) as vw:
-        for f in scene.frames():
-            vw.write(f)
+    encode(scene.frames(), path, fps=30.0)
     return {"people": people, "activities": activities}
 
 

@@ -36,15 +36,10 @@ def scene_frames(seed: int, domain: str, seconds: float, size=(320, 240)):
 
 def check(frames, n, path: Path, fps=30.0) -> dict:
     from wallcli.io.video import open_video
-    from wallcli.io.writer import VideoWriter
     from wallcli.signal.view import ViewCheck
+    from wallcli.sim.views import encode
 
-    frames = iter(frames)
-    first = next(frames)
-    with VideoWriter(path, fps, first.shape[1], first.shape[0], codec="libx264", crf=18) as vw:
-        vw.write(first)
-        for f in frames:
-            vw.write(f)
+    encode(frames, path, fps=fps)
     vc = ViewCheck()
     with open_video(path) as reader:
         for frame in reader.frames():

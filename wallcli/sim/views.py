@@ -78,6 +78,20 @@ def cut(frames: Iterable[np.ndarray], other: Iterable[np.ndarray], rng, *, n: in
         yield a if i < at else b
 
 
+def encode(frames: Iterable[np.ndarray], path, *, fps: float, crf: int = 18):
+    """Write uint8 RGB frames (the size of the first) as H.264 at ``crf``, as `wallcli simulate`
+    does; returns ``path``."""
+    from wallcli.io.writer import VideoWriter
+
+    frames = iter(frames)
+    first = next(frames)
+    with VideoWriter(path, fps, first.shape[1], first.shape[0], codec="libx264", crf=crf) as vw:
+        vw.write(first)
+        for f in frames:
+            vw.write(f)
+    return path
+
+
 def _chain(first, rest):
     yield first
     yield from rest
