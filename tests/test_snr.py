@@ -180,6 +180,36 @@ def test_roi_auto_finds_the_signal_patch(run_cli, tmp_path):
     assert data["roi_mode"] == "auto" and data["snr_db"][1] > 0
 
 
+def test_roi_auto_avoids_a_mover_in_view(run_cli, tmp_path):
+    """A dark object pacing in the left of the view changes its pixels far more than the faint
+    patch on the right: the view check marks where it went, and --roi auto picks the patch."""
+    rng = np.random.default_rng(6)
+    patch = (120, 48, 48, 48)  # x, y, w, h in a 192x128 frame
+    wall = 110.0 + 4.0 * rng.normal(0, 1.0, (128, 192, 1))  # some texture: an object has edges on it
+
+    def fn(i):
+        img = wall + rng.normal(0, 1.0, (128, 192, 3))
+        x, y, w, h = patch
+        img[y:y + h, x:x + w] += 3.0 * np.sin(2 * np.pi * i / PERIOD)
+        if i >= 30:  # it walks in after a second, slowly back and forth over x = 8-70
+            x0 = 8 + int(24 + 24 * np.sin(2 * np.pi * (i - 30) / 200))
+            img[30:100, x0:x0 + 14] = 45.0
+        return img
+
+    path = _lossless(tmp_path / "mover.mkv", fn)
+    heat = tmp_path / "where.png"
+    code, out, err = run_cli("snr", path, "--roi", "auto", "--json", "--heatmap", heat)
+    assert code == 0, err
+    assert heat.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    data = json.loads(out)
+    assert data["auto"]["avoided_cells"] > 0 and data["auto"]["avoided"] == ["moving object"], data["auto"]
+    x, y, w, h = data["roi"]
+    assert x >= 70, data["roi"]  # clear of everything the object covered (x < 70)
+    px, py, pw, ph = patch
+    inter = max(0, min(x + w, px + pw) - max(x, px)) * max(0, min(y + h, py + ph) - max(y, py))
+    assert inter / (w * h) > 0.5, data["roi"]
+
+
 def test_predict_equals_closed_forms(run_cli):
     d, r, a, lp, ls, q = 2.5, 0.3, 0.6, 30.0, 180.0, 0.4
     code, out, err = run_cli("snr", "--predict", "--json", "--distance", d, "--radius", r, "--albedo", a,

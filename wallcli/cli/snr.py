@@ -46,7 +46,8 @@ def snr(
     roi: Optional[str] = typer.Option(None, "--roi", metavar="X,Y,W,H|auto", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
                                       "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
                                       "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
-                                      "covariances). 'auto' reads the file twice. Default: whole frame."),
+                                      "covariances), leaving out cells where the view check saw a moving object, clipping or black. "
+                                      "'auto' reads the file twice. Default: whole frame."),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object (docs/contract.md fields, plus extras) on stdout."),
     heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
@@ -138,16 +139,28 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         raise WallcliError("--roi auto reads the video twice, so it needs a file (not '-' or a stream)"
                            if input == "-" or "://" in input else f"no such file: {input}")
     notes: list[str] = []
-    grid = auto_snr = None
+    grid = auto_snr = avoid = None
     if auto:
         with open_video(input, threads=threads) as reader:
             full = check_roi(None, reader.info.width, reader.info.height)
             grid = GridAccumulator(full, 16, covariance=True)
+            whole = ViewCheck()  # where the view fails (a mover, clipping) is no place for the ROI
             with progress("snr: finding the ROI", reader.info.frame_count) as advance:
                 for frame in reader.frames():
                     grid.update(frame.planes)
+                    whole(frame)
                     advance()
-        roi_t, auto_snr = grid.best_roi()
+        avoid = whole.avoid(grid.grid_roi, grid.rows, grid.cols)
+        try:
+            roi_t, auto_snr = grid.best_roi(avoid)
+        except ValueError:
+            notes.append("--roi auto: the view failed somewhere in every part of the frame (a mover "
+                         "or clipping); the ROI was chosen as if it had not")
+            roi_t, auto_snr = grid.best_roi()
+            avoid[:] = False
+        if avoid.any():
+            notes.append(f"--roi auto left out {int(avoid.sum())} of {avoid.size} cells where the view check saw "
+                         "a moving object, clipping or black")
     with open_video(input, threads=threads) as reader, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         roi_c = check_roi(roi_t, reader.info.width, reader.info.height)
@@ -176,11 +189,15 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     notes = result["warnings"]
     if auto:
         result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
-                          "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0))}
+                          "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0)),
+                          "avoided_cells": int(avoid.sum()),
+                          "avoided": [k for k in ("moving object", "clipped", "too dark", "too little usable area")
+                                      if k in whole.view()["issues"]] if avoid.any() else []}
     if heatmap is not None:
         from wallcli.plots.snr import save_heatmap_png
 
-        save_heatmap_png(heatmap, grid, of=heatmap_of, chosen=res.roi if auto else None, title=input, force=force)
+        save_heatmap_png(heatmap, grid, of=heatmap_of, chosen=res.roi if auto else None,
+                         avoid=avoid if auto else None, title=input, force=force)
     if plot is not None:
         from wallcli.plots.snr import save_scales_png
 

@@ -10,8 +10,10 @@ from wallcli.plots.figure import new_figure, save_figure
 COLOURS = ("tab:red", "tab:green", "tab:blue")
 
 
-def save_heatmap_png(path, grid, *, of: str = "signal", chosen=None, title: str = "", force: bool = False) -> None:
-    """Per-cell signal power (mean over R, G, B) or SNR (dB) over the mean luma of the grid's ROI."""
+def save_heatmap_png(path, grid, *, of: str = "signal", chosen=None, avoid=None, title: str = "",
+                     force: bool = False) -> None:
+    """Per-cell signal power (mean over R, G, B) or SNR (dB) over the mean luma of the grid's ROI;
+    ``avoid`` ((rows, cols) bool): cells --roi auto left out (the view failed there), hatched."""
     from matplotlib.patches import Rectangle
 
     sig, noi, lum = grid.maps()
@@ -28,9 +30,15 @@ def save_heatmap_png(path, grid, *, of: str = "signal", chosen=None, title: str 
         data, label = np.clip(s, 0, None), "signal power (8-bit code values$^2$), per cell"
     image = ax.imshow(np.ma.masked_invalid(data), cmap="inferno", alpha=0.65, extent=extent, interpolation="nearest")
     fig.colorbar(image, ax=ax, label=label, shrink=0.8)
+    if avoid is not None and avoid.any():
+        for i, j in zip(*np.nonzero(avoid)):
+            ax.add_patch(Rectangle((x + j * grid.cw, y + i * grid.ch), grid.cw, grid.ch, fill=False, hatch="xx",
+                                   edgecolor="white", lw=0, alpha=0.6,
+                                   label="view failed here" if (i, j) == tuple(np.argwhere(avoid)[0]) else None))
     if chosen is not None:
         cx, cy, cw, ch = chosen
         ax.add_patch(Rectangle((cx, cy), cw, ch, fill=False, edgecolor="cyan", lw=2, label="--roi auto"))
+    if chosen is not None or (avoid is not None and avoid.any()):
         ax.legend(loc="upper right", fontsize=8)
     ax.set_title(f"{title}: {grid.rows}x{grid.cols} cells of {grid.cw}x{grid.ch} px, {grid.frames} frames",
                  fontsize=10, loc="left")

@@ -511,8 +511,11 @@ class GridAccumulator:
         sig, noi = powers_from_sums(self.s1, self.s2, self.sd, dsum, self.frames, 1.0, ())
         return sig, noi, self.lum / self.frames
 
-    def best_roi(self) -> tuple[Roi, float]:
-        """The rectangle of whole cells whose spatially averaged grey level has the highest SNR.
+    def best_roi(self, avoid: np.ndarray | None = None) -> tuple[Roi, float]:
+        """The rectangle of whole cells whose spatially averaged grey level has the highest SNR,
+        among those with no cell marked in ``avoid`` ((rows, cols) bool: where the view check
+        saw the view fail; a mover in view would otherwise be the 'signal' chosen). Raises
+        ValueError when every rectangle holds a marked cell.
 
         Var of a rectangle's mean = (sum of the cells' covariances over the rectangle) / n^2, for
         signal and for frame differences alike; 4-D prefix sums give every rectangle at once.
@@ -527,6 +530,13 @@ class GridAccumulator:
                                                         np.arange(c + 1), np.arange(c + 1), indexing="ij"))
         keep = (y1 > y0) & (x1 > x0)
         y0, y1, x0, x1 = y0[keep], y1[keep], x0[keep], x1[keep]
+        if avoid is not None and avoid.any():
+            p = np.zeros((r + 1, c + 1))
+            p[1:, 1:] = np.cumsum(np.cumsum(avoid, axis=0), axis=1)
+            clean = (p[y1, x1] - p[y0, x1] - p[y1, x0] + p[y0, x0]) == 0
+            if not clean.any():
+                raise ValueError("every cell was marked")
+            y0, y1, x0, x1 = y0[clean], y1[clean], x0[clean], x1[clean]
         n = ((y1 - y0) * (x1 - x0)).astype(np.float64)
         total = _rect_quad(cov, r, c, y0, y1, x0, x1) / n**2
         noise = 0.5 * _rect_quad(covd, r, c, y0, y1, x0, x1) / n**2

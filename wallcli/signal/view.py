@@ -228,6 +228,10 @@ class ViewCheck:
         self._cut_sig: deque = deque(maxlen=HISTORY)
         self._cut_reset = False
         self._shifts: deque = deque(maxlen=HOLD_WITHIN)  # recent significant shifts (inf: none)
+        # where the view failed, per block (clipped, too dark, or a mover in it), OR-ed over the
+        # checked frames, and where those blocks lie in source pixels: what `snr --roi auto` avoids
+        self._bad = None
+        self._bad_geometry = None
 
     def __call__(self, frame) -> None:
         self.update(frame.time, frame.planes)
@@ -293,6 +297,7 @@ class ViewCheck:
 
         small, w = _grey(planes, self.roi, MAX_SIDE)
         self._scale = 1.0 / (small.shape[1] / w)
+        self._full_small = small.shape
         small = _whole_blocks(small)
         bh, bw = (n // _block_side(small.shape) for n in small.shape)
         blocks = cv2.resize(small, (bw, bh), interpolation=cv2.INTER_AREA)
@@ -302,6 +307,7 @@ class ViewCheck:
             clipped = np.zeros(blocks.shape, bool)
         dark = (blocks < DARK) & ~clipped
         ok = ~(clipped | dark)
+        self._note_bad(~ok, small.shape)
         usable = float(ok.mean())
         self.min_usable = min(self.min_usable, usable)
         flags = set()
@@ -322,6 +328,38 @@ class ViewCheck:
         self.frames += 1
         for kind in flags:
             self._mark(kind, t)
+
+    def _note_bad(self, bad: np.ndarray, cropped: tuple[int, int]) -> None:
+        """OR ``bad`` (per block) into the clip's map, and remember where the blocks lie: the
+        block grid tiles the centre of the downscaled frame (see _whole_blocks)."""
+        if self._bad is None or self._bad.shape != bad.shape:
+            self._bad = np.zeros(bad.shape, bool)
+            side = _block_side(cropped)
+            x0, y0 = (self.roi[0], self.roi[1]) if self.roi is not None else (0, 0)
+            sh, sw = self._full_small
+            self._bad_geometry = (x0, y0, side, (sh - cropped[0]) // 2, (sw - cropped[1]) // 2, self._scale)
+        self._bad |= bad
+
+    def avoid(self, roi, rows: int, cols: int) -> np.ndarray:
+        """(rows, cols) bool: the cells of a grid over ``roi`` (x, y, w, h in source pixels) that
+        overlap a block where the view failed on some checked frame (clipped, too dark, or a
+        moving object in it). A whole-frame failure (camera motion, a cut) marks no cell: no
+        part of the frame escapes it."""
+        out = np.zeros((rows, cols), bool)
+        if self._bad is None or not self._bad.any():
+            return out
+        x0, y0, side, dh, dw, scale = self._bad_geometry
+        gx, gy, gw, gh = roi
+        cw, ch = gw / cols, gh / rows
+        for i, j in zip(*np.nonzero(self._bad)):
+            # the block's source rectangle, then the cells it overlaps (open intervals: a block
+            # that only touches a cell's edge leaves the cell alone)
+            bx0, bx1 = x0 + (dw + j * side) * scale, x0 + (dw + (j + 1) * side) * scale
+            by0, by1 = y0 + (dh + i * side) * scale, y0 + (dh + (i + 1) * side) * scale
+            c0, c1 = int(np.floor((bx0 - gx) / cw)), int(np.ceil((bx1 - gx) / cw))
+            r0, r1 = int(np.floor((by0 - gy) / ch)), int(np.ceil((by1 - gy) / ch))
+            out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
+        return out
 
     def _reset(self, hp, small, blocks) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
@@ -400,6 +438,7 @@ class ViewCheck:
         hit = broad & (np.sqrt(energy) > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & ok
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
+            self._bad |= hit
         if suspect or moved or (broad & ok).any():
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
