@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 
-def _clip(seed: int, rms: float, features: float, path: Path) -> dict:
+def _clip(seed: int, rms: float, features: float, path: Path, crf: int = 18) -> dict:
     from wallcli.sim.scene import SceneConfig, sample_scene
 
     rng = np.random.default_rng(seed)
@@ -38,7 +38,7 @@ def _clip(seed: int, rms: float, features: float, path: Path) -> dict:
                       camera_overrides={"shake": rms, "shake_exact": True, "features": features,
                                         "drift": 0.0, "flicker": 0.0, "ae_steps": 0})
     scene = sample_scene(seed, cfg)
-    encode(scene.frames(), path, fps=30.0)
+    encode(scene.frames(), path, fps=30.0, crf=crf)
     return {"people": people, "activities": activities}
 
 
@@ -64,6 +64,8 @@ def main() -> None:
     ap.add_argument("--rms", type=float, default=0.5)
     ap.add_argument("--features", type=float, default=0.3)
     ap.add_argument("--seed", type=int, default=7000)
+    ap.add_argument("--crf", type=int, default=18, help="x264 CRF of both clips (0: lossless, so the codec's "
+                    "repeating of a still wall's blocks does not hide the still clip's noise)")
     ap.add_argument("--json", type=Path)
     a = ap.parse_args()
     from wallcli.infer.model import load_model
@@ -74,8 +76,8 @@ def main() -> None:
         for i in range(a.n):
             seed = a.seed + i
             still, shaky = Path(tmp) / f"{seed}_still.mp4", Path(tmp) / f"{seed}_shake.mp4"
-            truth = _clip(seed, 0.0, a.features, still)
-            _clip(seed, a.rms, a.features, shaky)
+            truth = _clip(seed, 0.0, a.features, still, a.crf)
+            _clip(seed, a.rms, a.features, shaky, a.crf)
             rec = {"seed": seed, **truth}
             for task, model in models.items():
                 rec[task] = {"still": _answers(model, still, False),
@@ -85,7 +87,7 @@ def main() -> None:
             print(json.dumps(rec), file=sys.stderr, flush=True)
     if a.json:
         a.json.write_text(json.dumps(rows, indent=1))
-    print(f"{a.n} scenes, shake {a.rms} px rms per axis, features {a.features}:")
+    print(f"{a.n} scenes, shake {a.rms} px rms per axis, features {a.features}, crf {a.crf}:")
     for task in models:
         for side in ("shake_off", "shake_on"):
             kept = sum(r[task][side]["label"] == r[task]["still"]["label"] for r in rows)
