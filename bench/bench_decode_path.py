@@ -76,6 +76,8 @@ def main() -> None:
     ap.add_argument("--pairs", type=int, default=5)
     ap.add_argument("--vertical", action=argparse.BooleanOptionalAction, default=True,
                     help="also the vertical profile (stplot, activity); --no-vertical: count's horizontal only")
+    ap.add_argument("--fresh-noise", action="store_true",
+                    help="a clip with new noise in every frame (camera-like decode cost) instead of the 8 reused fields")
     ap.add_argument("--job", choices=["decode", "path"], help=argparse.SUPPRESS)
     ap.add_argument("--clip", help=argparse.SUPPRESS)
     a = ap.parse_args()
@@ -84,9 +86,9 @@ def main() -> None:
         return
     from clips import clip_1080p
 
-    clip = clip_1080p(a.frames)
+    clip = clip_1080p(a.frames, fresh=a.fresh_noise)
     ratios, cpu_ratios = [], []
-    print(f"1080p30 H.264, {a.frames} frames, {a.pairs} pairs, vertical={a.vertical}; "
+    print(f"1080p30 H.264{' (fresh noise every frame)' if a.fresh_noise else ''}, {a.frames} frames, {a.pairs} pairs, vertical={a.vertical}; "
           f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     for i in range(a.pairs):
         d, p = _run("decode", clip, a.vertical), _run("path", clip, a.vertical)
