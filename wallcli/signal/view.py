@@ -24,6 +24,11 @@ MAX_SIDE = 320  # registration scale: finer texture than this is not needed to s
 BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
 K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) from its slow background
 REL_EDGE = 0.10  # whose fine structure changed by an RMS over this fraction of the level
+SHARP = 0.10  # and over this fraction of the step it bounds (the largest change among the block and
+# its 8 neighbours): an in-focus outline (blurred by a pixel or less) puts 0.09-0.11 of its step into
+# the fine band on its own, a penumbra of 4 px or more under 0.05; simulated hard shadows of people
+# 1-2 m from the wall reached 10-19 % of the level in fine residue (the codec re-coding a change of
+# half the level), at under a tenth of their step (research/view/README.md, session 17)
 FINE = 2.0  # pixels (at the registration scale): the outline's scale
 EDGE_LEVEL = 40.0  # code values: under it, the level floor (noise, not contrast, rules dark walls)
 K_CUT = 8.0
@@ -317,7 +322,7 @@ class ViewCheck:
             self._reset(hp, small, blocks)
             self._cut_reset = False
         else:
-            flags |= self._changes(t, blocks, hp, ok, small)
+            flags |= self._changes(t, blocks, hp, ok, small, clipped)
         self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
         self.frames += 1
         for kind in flags:
@@ -327,7 +332,7 @@ class ViewCheck:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
 
-    def _changes(self, t, blocks, hp, ok, small) -> set:
+    def _changes(self, t, blocks, hp, ok, small, clipped) -> set:
         import cv2
 
         flags = set()
@@ -387,20 +392,29 @@ class ViewCheck:
             self.max_shift = max(self.max_shift, shift)
         # something in view: a block far brighter or darker than its slow background (beyond
         # the noise and beyond any hidden person's few per cent) whose fine structure changed
-        # too (an object's outline); a hidden person's shadow, even a hard one from a window, has
-        # edges blurred by its penumbra and changes the fine scale far less
+        # too (an object's outline), by a fair part of the step it bounds (SHARP); a hidden
+        # person's shadow, even a hard one from a window, has edges blurred by its penumbra and
+        # changes the fine scale far less for its step
         a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
         g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
-        broad = np.abs(blocks - g * self._bg_b) > np.maximum(K_MOVER * sigma, REL * level)
+        dev = np.abs(blocks - g * self._bg_b)
+        broad = dev > np.maximum(K_MOVER * sigma, REL * level)
         fine = _highpass(small, FINE)
         # light falling on the wall scales its texture with it: compare with the background's
         # texture scaled by each block's change of level, so a shadow's dimming is not an outline
         scale = cv2.resize(blocks / np.maximum(g * self._bg_b, 1.0), fine.shape[::-1], interpolation=cv2.INTER_LINEAR)
         energy = cv2.resize((fine - scale * self._bg_h) ** 2, blocks.shape[::-1], interpolation=cv2.INTER_AREA)
-        hit = broad & (np.sqrt(energy) > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & ok
+        edge = np.sqrt(energy)
+        step = cv2.dilate(np.where(ok, dev, 0.0).astype(np.float32), np.ones((3, 3), np.uint8))
+        hit = broad & (edge > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & (edge > SHARP * step) & ok
+        # a bright object saturates: blocks clipped now whose background was well inside the usable
+        # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
+        # rules above never see them, as clipped blocks are not 'ok'
+        covered = broad & clipped & (g * self._bg_b * (1 + 2 * REL) < CLIP_HI)
+        hit |= covered
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
-        if suspect or moved or (broad & ok).any():
+        if suspect or moved or (broad & ok).any() or covered.any():
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
