@@ -23,12 +23,21 @@ import numpy as np
 MAX_SIDE = 320  # registration scale: finer texture than this is not needed to see a pan
 BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
 K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) from its slow background
-REL_EDGE = 0.10  # whose fine structure changed by an RMS over this fraction of the level
-SHARP = 0.10  # and over this fraction of the step it bounds (the largest change among the block and
+REL_EDGE = 0.05  # whose fine structure changed by an RMS over this fraction of the level (REL: no
+# hidden person changes the wall by that much, outline or not)
+K_EDGE = 4.0  # and this many spreads above the frame's median block residual (its noise, texture
+# and codec residue in the fine band): the RMS of n pixels spreads by about median/sqrt(2 n), n
+# counted as a quarter of the block's pixels (see K_SHIFT); a block of a 96-pixel-wide frame is 2x2
+# pixels, of a 320-pixel one 8x8 (three refused some transfer-set walls as movers; six
+# missed a 40-60 % sprite on a dark noisy wall that four catches)
+SHARP = 0.15  # and over this fraction of the step it bounds (the largest change among the block and
 # its 8 neighbours): an in-focus outline (blurred by a pixel or less) puts 0.09-0.11 of its step into
-# the fine band on its own, a penumbra of 4 px or more under 0.05; simulated hard shadows of people
-# 1-2 m from the wall reached 10-19 % of the level in fine residue (the codec re-coding a change of
-# half the level), at under a tenth of their step (research/view/README.md, session 17)
+# the fine band on its own and the wall texture it hides adds to that (simulated objects: 0.2 and
+# more), a penumbra of 4 px or more puts under 0.05; deep simulated shadows (half the level) reached
+# 0.13 with the codec's re-coding residue on top. Session 17 (research/view/README.md):
+# with a floor of 10 % of the level alone, faint objects (15-40 % contrast) were caught a quarter of
+# the time, while hard shadows of people 1-2 m from the wall (half the level, the codec re-coding
+# them) were refused as movers; these three together catch more of the one and none of the other
 FINE = 2.0  # pixels (at the registration scale): the outline's scale
 EDGE_LEVEL = 40.0  # code values: under it, the level floor (noise, not contrast, rules dark walls)
 K_CUT = 8.0
@@ -406,7 +415,10 @@ class ViewCheck:
         energy = cv2.resize((fine - scale * self._bg_h) ** 2, blocks.shape[::-1], interpolation=cv2.INTER_AREA)
         edge = np.sqrt(energy)
         step = cv2.dilate(np.where(ok, dev, 0.0).astype(np.float32), np.ones((3, 3), np.uint8))
-        hit = broad & (edge > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & (edge > SHARP * step) & ok
+        n = max(_block_side(small.shape) ** 2 / 4.0, 1.0)
+        noise = _upper_median(edge[ok]) * (1.0 + K_EDGE / np.sqrt(2.0 * n))
+        floor = np.maximum(REL_EDGE * np.maximum(blocks, EDGE_LEVEL), noise)
+        hit = broad & (edge > floor) & (edge > SHARP * step) & ok
         # a bright object saturates: blocks clipped now whose background was well inside the usable
         # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
         # rules above never see them, as clipped blocks are not 'ok'
