@@ -128,7 +128,8 @@ def check(a) -> None:
     if a.transfer:
         todo = [{"file": p.name, "kind": "transfer", "param": None, "path": p} for p in sorted(Path(a.transfer).glob("*.mp4"))]
     else:
-        todo = [{**r, "path": a.out / r["file"]} for r in map(json.loads, (a.out / "manifest.jsonl").read_text().splitlines())]
+        todo = [{**r, "path": a.out / r["file"]} for r in map(json.loads, (a.out / "manifest.jsonl").read_text().splitlines())
+                if not a.kinds or r["kind"] in a.kinds.split(",")]
     rows = []
     for r in todo:
         path = r.pop("path")
@@ -156,6 +157,7 @@ def main() -> None:
     c = sub.add_parser("check")
     c.add_argument("--out", type=Path, default=Path("/tmp/view17"))
     c.add_argument("--transfer", type=Path)
+    c.add_argument("--kinds", help="only these kinds of clip, comma-separated (wall,sprite,faint,cut,pan,shake)")
     c.add_argument("--json", type=Path, help="verdicts, one clip a line (resumed if present)")
     a = ap.parse_args()
     make(a) if a.cmd == "make" else check(a)
