@@ -231,6 +231,7 @@ class ViewCheck:
         self._sig_b: deque = deque(maxlen=HISTORY)
         self._sig_h: deque = deque(maxlen=HISTORY)
         self._prev_b = self._prev_h = self._ref_h = self._bg_h = self._bg_b = None
+        self._bg_n = 0  # frames averaged into the background since the last reset
         self._t_prev = None
         self._t_checked = -np.inf
         self._dense_until = -np.inf
@@ -340,6 +341,7 @@ class ViewCheck:
     def _reset(self, hp, small, blocks) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
+        self._bg_n = 1
 
     def _changes(self, t, blocks, hp, ok, small, clipped) -> set:
         import cv2
@@ -405,6 +407,10 @@ class ViewCheck:
         # person's shadow, even a hard one from a window, has edges blurred by its penumbra and
         # changes the fine scale far less for its step
         a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
+        # until it has 2 s of frames, the background is their plain mean: one frame's noise (the
+        # first is often the codec's intra frame, coded unlike the rest) is not the wall's
+        self._bg_n += 1
+        a = max(a, 1.0 / self._bg_n)
         g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
         dev = np.abs(blocks - g * self._bg_b)
         broad = dev > np.maximum(K_MOVER * sigma, REL * level)
