@@ -159,3 +159,44 @@ def test_real_footage_that_is_not_a_wall_is_refused(name):
     view = _check(_real_clip(name))
     assert not view["usable"], view
     assert set(view["issues"]) & {"moving object", "camera motion", "scene cut"}, view
+
+
+def test_a_bright_object_that_clips_is_a_moving_object(tmp_path):
+    """A white object crossing a bright wall saturates the sensor: the blocks it covers are clipped
+    (not 'usable'), and its outline against a wall of level 205 is too faint for the outline rule;
+    blocks clipped now over a background well under clipping are something that covers the wall."""
+    import cv2
+
+    from clips import write_clip
+
+    h, w, n = 240, 320, 90
+    rng = np.random.default_rng(0)
+    texture = 1 + 0.04 * cv2.GaussianBlur(rng.standard_normal((h, w)).astype(np.float32), (0, 0), 0.8) / 0.3
+
+    def frame(i, obj=True):
+        img = 205.0 * texture + rng.normal(0, 1.0, (h, w))
+        if obj:
+            m = np.zeros((h, w), np.float32)
+            cv2.ellipse(m, (int(-60 + i * (w + 120) / n), h // 2), (30, 80), 0, 0, 360, 1.0, -1)
+            m = cv2.GaussianBlur(m, (0, 0), 0.7)
+            img = img * (1 - m) + 255.0 * m
+        return np.repeat(img[..., None], 3, 2)
+
+    opts = {"crf": "18", "preset": "medium"}
+    crossed = _check(write_clip(tmp_path / "white.mp4", frame, n, options=opts))
+    assert not crossed["usable"] and "moving object" in crossed["issues"], crossed
+    wall = _check(write_clip(tmp_path / "wall.mp4", lambda i: frame(i, obj=False), n, options=opts))
+    assert wall["usable"], wall
+
+
+def test_hard_shadows_of_people_near_the_wall_are_not_moving_objects(tmp_path):
+    """Two hidden people 1-2 m from a wall in the 'steady' domain: their shadows change the wall
+    by half its level with the codec's re-coding residue on top (10-25 % of the shadowed level in
+    the fine band), but at under a tenth of the step: no outline (SHARP). Before the rule this
+    clip was refused as a moving object."""
+    from wallcli.sim.scene import SceneConfig, sample_scene
+
+    cfg = SceneConfig(people=2, duration=SECONDS, fps=FPS, width=320, height=240, domain="steady", codec="libx264",
+                      crf=18, nuisance_p=0.5, distance=(1.0, 2.0))
+    view = _check(_encode(tmp_path / "s.mp4", sample_scene(3, cfg).frames()))
+    assert view["usable"], view

@@ -23,7 +23,21 @@ import numpy as np
 MAX_SIDE = 320  # registration scale: finer texture than this is not needed to see a pan
 BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
 K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) from its slow background
-REL_EDGE = 0.10  # whose fine structure changed by an RMS over this fraction of the level
+REL_EDGE = 0.05  # whose fine structure changed by an RMS over this fraction of the level (REL: no
+# hidden person changes the wall by that much, outline or not)
+K_EDGE = 4.0  # and this many spreads above the frame's median block residual (its noise, texture
+# and codec residue in the fine band): the RMS of n pixels spreads by about median/sqrt(2 n), n
+# counted as a quarter of the block's pixels (see K_SHIFT); a block of a 96-pixel-wide frame is 2x2
+# pixels, of a 320-pixel one 8x8 (three refused some transfer-set walls as movers; six
+# missed a 40-60 % sprite on a dark noisy wall that four catches)
+SHARP = 0.15  # and over this fraction of the step it bounds (the largest change among the block and
+# its 8 neighbours): an in-focus outline (blurred by a pixel or less) puts 0.09-0.11 of its step into
+# the fine band on its own and the wall texture it hides adds to that (simulated objects: 0.2 and
+# more), a penumbra of 4 px or more puts under 0.05; deep simulated shadows (half the level) reached
+# 0.13 with the codec's re-coding residue on top. Session 17 (research/view/README.md):
+# with a floor of 10 % of the level alone, faint objects (15-40 % contrast) were caught a quarter of
+# the time, while hard shadows of people 1-2 m from the wall (half the level, the codec re-coding
+# them) were refused as movers; these three together catch more of the one and none of the other
 FINE = 2.0  # pixels (at the registration scale): the outline's scale
 EDGE_LEVEL = 40.0  # code values: under it, the level floor (noise, not contrast, rules dark walls)
 K_CUT = 8.0
@@ -217,6 +231,7 @@ class ViewCheck:
         self._sig_b: deque = deque(maxlen=HISTORY)
         self._sig_h: deque = deque(maxlen=HISTORY)
         self._prev_b = self._prev_h = self._ref_h = self._bg_h = self._bg_b = None
+        self._bg_n = 0  # frames averaged into the background since the last reset
         self._t_prev = None
         self._t_checked = -np.inf
         self._dense_until = -np.inf
@@ -323,7 +338,7 @@ class ViewCheck:
             self._reset(hp, small, blocks)
             self._cut_reset = False
         else:
-            flags |= self._changes(t, blocks, hp, ok, small)
+            flags |= self._changes(t, blocks, hp, ok, small, clipped)
         self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
         self.frames += 1
         for kind in flags:
@@ -364,8 +379,9 @@ class ViewCheck:
     def _reset(self, hp, small, blocks) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
+        self._bg_n = 1
 
-    def _changes(self, t, blocks, hp, ok, small) -> set:
+    def _changes(self, t, blocks, hp, ok, small, clipped) -> set:
         import cv2
 
         flags = set()
@@ -425,21 +441,37 @@ class ViewCheck:
             self.max_shift = max(self.max_shift, shift)
         # something in view: a block far brighter or darker than its slow background (beyond
         # the noise and beyond any hidden person's few per cent) whose fine structure changed
-        # too (an object's outline); a hidden person's shadow, even a hard one from a window, has
-        # edges blurred by its penumbra and changes the fine scale far less
+        # too (an object's outline), by a fair part of the step it bounds (SHARP); a hidden
+        # person's shadow, even a hard one from a window, has edges blurred by its penumbra and
+        # changes the fine scale far less for its step
         a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
+        # until it has 2 s of frames, the background is their plain mean: one frame's noise (the
+        # first is often the codec's intra frame, coded unlike the rest) is not the wall's
+        self._bg_n += 1
+        a = max(a, 1.0 / self._bg_n)
         g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
-        broad = np.abs(blocks - g * self._bg_b) > np.maximum(K_MOVER * sigma, REL * level)
+        dev = np.abs(blocks - g * self._bg_b)
+        broad = dev > np.maximum(K_MOVER * sigma, REL * level)
         fine = _highpass(small, FINE)
         # light falling on the wall scales its texture with it: compare with the background's
         # texture scaled by each block's change of level, so a shadow's dimming is not an outline
         scale = cv2.resize(blocks / np.maximum(g * self._bg_b, 1.0), fine.shape[::-1], interpolation=cv2.INTER_LINEAR)
         energy = cv2.resize((fine - scale * self._bg_h) ** 2, blocks.shape[::-1], interpolation=cv2.INTER_AREA)
-        hit = broad & (np.sqrt(energy) > REL_EDGE * np.maximum(blocks, EDGE_LEVEL)) & ok
+        edge = np.sqrt(energy)
+        step = cv2.dilate(np.where(ok, dev, 0.0).astype(np.float32), np.ones((3, 3), np.uint8))
+        n = max(_block_side(small.shape) ** 2 / 4.0, 1.0)
+        noise = _upper_median(edge[ok]) * (1.0 + K_EDGE / np.sqrt(2.0 * n))
+        floor = np.maximum(REL_EDGE * np.maximum(blocks, EDGE_LEVEL), noise)
+        hit = broad & (edge > floor) & (edge > SHARP * step) & ok
+        # a bright object saturates: blocks clipped now whose background was well inside the usable
+        # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
+        # rules above never see them, as clipped blocks are not 'ok'
+        covered = broad & clipped & (g * self._bg_b * (1 + 2 * REL) < CLIP_HI)
+        hit |= covered
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
             self._bad |= hit
-        if suspect or moved or (broad & ok).any():
+        if suspect or moved or (broad & ok).any() or covered.any():
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
