@@ -349,12 +349,16 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
             ptp = 0.0
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
     model = model + steps_g
-    steps = [(j, float(s)) for j, s in sorted(zip(found, sizes))]
-    for j, _ in steps:  # within a ramp the step's shape is what was measured, not a jump
+    order = sorted(found)
+    for j in order:  # within a ramp the step's shape is what was measured, not a jump
         lo, hi = max(j - half - 1, 0), min(j + half + 1, t)
         around = np.arange(max(lo - span, 0), min(hi + span, t))
         around = around[keep[around]]
         model[lo:hi] = g[lo:hi] - (np.median((g - model)[around]) if around.size else 0.0)
+    # each step's size as the model has it: the change across its ramp (where two ramps touch, the
+    # level between them is only seen there, not in the fitted jumps)
+    steps = [(j, float(np.mean(model[min(j + half + 1, t - 1):min(j + half + 3, t)])
+                        - np.mean(model[max(j - half - 3, 0):max(j - half - 1, 1)]))) for j in order]
     return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
 
 
