@@ -47,7 +47,6 @@ STEP_SIGMA = 10.0  # and in units of the gain's frame-to-frame noise
 RAMP_S = 0.33  # seconds an exposure step may take
 SPAN_S = 0.5  # seconds averaged on each side of a step
 EDGE_S = 0.17  # or as little as this where the window ends or another step begins
-SIZE_S = 1.5  # seconds on each side of a step its size is fitted over
 MAX_STEPS = 4
 DRIFT_DEGREE = 3
 DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
@@ -255,8 +254,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     and most bins stepped alike (``AGREE``) in every profile (``part`` (K,): which profile each bin
     is of; a person's shadow can dim all the rows of a wall alike, not also all its columns); so is
     the drift. Each step's size is the median of the bins' own (a shadow moves a fit of the median
-    over the bins), each bin's fitted over ``SIZE_S`` seconds on either side with every step there
-    (close steps are sized together). Works on logarithms of the levels (:func:`fit`): gains add."""
+    over the bins), each bin's fitted with the other steps taken out (close steps are sized again
+    once all are found). Works on logarithms of the levels (:func:`fit`): gains add."""
     t = rel.shape[0]
     g = _robust_gain(rel)
     basis = _legendre(t, DRIFT_DEGREE)
@@ -275,8 +274,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     blocked: list[int] = []
     n = np.arange(t)
 
-    def stepped() -> np.ndarray:
-        return sum((s * (n >= j) for j, s in zip(found, sizes)), np.zeros(t))
+    def stepped(skip: int = -1) -> np.ndarray:
+        return sum((s * (n >= j) for i, (j, s) in enumerate(zip(found, sizes)) if i != skip), np.zeros(t))
 
     def counts(j: int) -> tuple[float, float]:
         nb = w[max(j - half - span, 0):max(j - half, 0)].sum()
@@ -320,21 +319,12 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
             w[max(j - half - 1, 0):min(j + half + 1, t)] = 0.0
         else:
             blocked.append(j)  # uneven along the wall: someone's shadow, kept
-    if found:
-        # the sizes again, each from the bins' own fits over SIZE_S seconds around it (a level, a
-        # slope, a curvature, every step within; the ramps left out), the median over the bins:
-        # three times the samples of the half-second spans, so that a person's quick change beside
-        # a step (a jump) moves it less, and close steps sized together
-        reach = max(span, int(round(SIZE_S * rate)))
+    for _ in range(2 if len(found) > 1 else 0):
+        # a step whose spans reached across another one, found after it, was sized with that one in
+        # them: size it again with the others' sizes taken out
         for i, j in enumerate(found):
-            lo, hi = max(j - half - reach, 0), min(j + half + reach, t)
-            idx = np.arange(lo, hi)
-            idx = idx[w[idx] > 0]
-            x = (idx - j) / reach
-            inside = [k for k in found if lo < k < hi]
-            design = np.stack([np.ones_like(x), x, x * x] + [(idx >= k).astype(np.float64) for k in inside], axis=1)
-            coef = _solve(design, rel[idx])
-            sizes[i] = float(np.median(coef[3 + inside.index(j)]))
+            if any(abs(j - k) < half + span for k in found if k != j):
+                sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, half, span)))
     steps_g = stepped()
     keep = w > 0
     nb = basis.shape[1]
