@@ -56,6 +56,7 @@ UNEVEN = 0.2  # a bin's change within this fraction of the common one (plus its 
 UNEVEN_DRIFT = 0.4  # the same for drift: a passing shadow bends a bin's slow curve (a cubic) a little
 AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change alike for a step or drift
 AGREE_EACH = 0.5  # and in each profile
+PAIRS = True  # two quick ramps a few tenths apart, with a level between, judged as one step
 AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged on
 
 
@@ -242,6 +243,40 @@ def _rise(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> int:
     return end - start
 
 
+def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[int, int] | None:
+    """(first, end) samples of a change of ``g`` around ``j`` made of two quick ramps (each within
+    ``ramp`` + 3 samples, 10 % to 90 % of the whole) with a level between them (3 samples that move
+    by under 5 % of the change), or None. Two steps of the light a few tenths of a second apart look
+    like one change too slow for a light's; a person's change over as long has no level in it."""
+    t = g.size
+    reach = 2 * ramp
+    before, after = _masked_means(g, w, np.array([j]), reach, span, 2)
+    before, after = float(before[0]), float(after[0])
+    if not np.isfinite(before) or not np.isfinite(after) or after == before:
+        return None
+    lo, hi = max(j - reach - span, 0), min(j + reach + span, t)
+    seg = g[lo:hi].copy()
+    out = w[lo:hi] == 0
+    pos = np.arange(lo, hi)
+    seg[out & (pos < j)] = before
+    seg[out & (pos >= j)] = after
+    f = (np.convolve(seg, np.ones(3) / 3, mode="same") - before) / (after - before)
+    f[0], f[-1] = f[1], f[-2]
+    above = np.flatnonzero(f >= 0.9)
+    if above.size == 0:
+        return None
+    end = int(above[0])
+    below = np.flatnonzero(f[:end] <= 0.1)
+    if below.size == 0:
+        return None
+    start = int(below[-1])
+    for a in range(start + 1, end - 2):
+        if abs(f[a + 2] - f[a]) < 0.05 and 0.15 < f[a] < 0.85:
+            if a - start <= ramp + 3 and end - (a + 2) <= ramp + 3:
+                return lo + start, lo + end + 1
+    return None
+
+
 def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
     """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
     changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins.
@@ -271,6 +306,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     w = np.ones(t)  # 0 on found steps' ramps, which the steps' model (a jump) does not describe
     found: list[int] = []
     sizes: list[float] = []
+    halves: list[int] = []  # each step's half-width of ramp (two quick ramps together: wider)
     blocked: list[int] = []
     n = np.arange(t)
 
@@ -308,23 +344,29 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         ok = min(nb, na) >= 2
         if ok:
             others = stepped()
-            per_bin = _local_steps(rel - others[:, None], w, j, half, span)
-            common = np.array([np.median(per_bin)])
-            tol = 4 * sigma * np.sqrt(1.0 / nb + 1.0 / na)
-            ok = (abs(common[0]) >= thr and _rise(g - others, w, j, half, span) <= ramp + 3
-                  and _agree(per_bin[:, None], common, tol, part))
+            hj = half
+            if _rise(g - others, w, j, half, span) > ramp + 3:
+                two = _pair(g - others, w, j, ramp, span) if PAIRS else None
+                hj = max(j - two[0], two[1] - j) if two is not None else -1
+            ok = hj >= 0
+            if ok:
+                per_bin = _local_steps(rel - others[:, None], w, j, hj, span)
+                common = np.array([np.median(per_bin)])
+                tol = 4 * sigma * np.sqrt(1.0 / nb + 1.0 / na)
+                ok = abs(common[0]) >= thr and _agree(per_bin[:, None], common, tol, part)
         if ok:
             found.append(j)
             sizes.append(float(common[0]))
-            w[max(j - half - 1, 0):min(j + half + 1, t)] = 0.0
+            halves.append(hj)
+            w[max(j - hj - 1, 0):min(j + hj + 1, t)] = 0.0
         else:
             blocked.append(j)  # uneven along the wall: someone's shadow, kept
     for _ in range(2 if len(found) > 1 else 0):
         # a step whose spans reached across another one, found after it, was sized with that one in
         # them: size it again with the others' sizes taken out
         for i, j in enumerate(found):
-            if any(abs(j - k) < half + span for k in found if k != j):
-                sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, half, span)))
+            if any(abs(j - k) < halves[i] + span for k in found if k != j):
+                sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
     steps_g = stepped()
     keep = w > 0
     nb = basis.shape[1]
@@ -339,16 +381,16 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
             ptp = 0.0
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
     model = model + steps_g
-    order = sorted(found)
-    for j in order:  # within a ramp the step's shape is what was measured, not a jump
-        lo, hi = max(j - half - 1, 0), min(j + half + 1, t)
+    order = sorted(zip(found, halves))
+    for j, hj in order:  # within a ramp the step's shape is what was measured, not a jump
+        lo, hi = max(j - hj - 1, 0), min(j + hj + 1, t)
         around = np.arange(max(lo - span, 0), min(hi + span, t))
         around = around[keep[around]]
         model[lo:hi] = g[lo:hi] - (np.median((g - model)[around]) if around.size else 0.0)
     # each step's size as the model has it: the change across its ramp (where two ramps touch, the
     # level between them is only seen there, not in the fitted jumps)
-    steps = [(j, float(np.mean(model[min(j + half + 1, t - 1):min(j + half + 3, t)])
-                        - np.mean(model[max(j - half - 3, 0):max(j - half - 1, 1)]))) for j in order]
+    steps = [(j, float(np.mean(model[min(j + hj + 1, t - 1):min(j + hj + 3, t)])
+                        - np.mean(model[max(j - hj - 3, 0):max(j - hj - 1, 1)]))) for j, hj in order]
     return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
 
 
