@@ -285,8 +285,9 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     found step's ramp left out) leaves: where the means of the ``SPAN_S`` seconds on either side of
     a ``RAMP_S`` differ by more than STEP_MIN and STEP_SIGMA noise. A step may lie as close to
     another as a ramp (the spans reach across the other, which the fit holds), and as close to the
-    window's ends as ``least`` samples of plateau. One is kept only where it is quick (``_rise``)
-    and most bins stepped alike (``AGREE``) in every profile (``part`` (K,): which profile each bin
+    window's ends as ``least`` samples of plateau. One is kept only where it is quick (``_rise``;
+    or two quick ramps with a level between them, ``_pair``, taken as one step) and most bins
+    stepped alike (``AGREE``) in every profile (``part`` (K,): which profile each bin
     is of; a person's shadow can dim all the rows of a wall alike, not also all its columns); so is
     the drift. Each step's size is the median of the bins' own (a shadow moves a fit of the median
     over the bins), each bin's fitted with the other steps taken out (close steps are sized again
