@@ -87,6 +87,87 @@ def test_an_exposure_step_is_found_and_removed():
     assert _residual(x / (1 + fit.gain), clean) < 0.1
 
 
+@pytest.mark.parametrize("gap", [0.15, 0.3, 0.45])
+def test_two_close_steps_are_fitted_jointly(gap):
+    """Two exposure steps closer than the half second averaged on either side of one (issue 27:
+    the first detector blocked the second, and the drift fit took up what was left): both are
+    found, each sized within 10 % (30 % where their ramps touch), and the correction leaves a tenth of the walker's signal."""
+    rng = np.random.default_rng(6)
+    clean = _wall(rng, _walker())
+    first = np.clip((t - 4.0) / 0.2, 0, 1)
+    second = np.clip((t - (4.2 + gap)) / 0.1, 0, 1)
+    x = clean * ((1 - 0.02 * first) * (1 + 0.02 * second))[:, None]
+    fit = C.fit(x, FPS, lines=[10.0], vertical=VERT, part=PART)
+    kinds = {f["kind"]: f for f in fit.findings}
+    steps = kinds["exposure"]["steps"]
+    assert len(steps) == 2 and "drift" not in kinds
+    assert steps[0]["time"] == pytest.approx(4.1, abs=0.1) and steps[1]["time"] == pytest.approx(4.25 + gap, abs=0.15)
+    rel = 0.1 if gap >= 0.3 else 0.3  # where the ramps touch, the level between them is seen in a few frames
+    assert steps[0]["size"] == pytest.approx(-0.02, rel=rel) and steps[1]["size"] == pytest.approx(0.02, rel=rel)
+    assert _residual(x / (1 + fit.gain), clean) < 0.1
+
+
+def test_two_steps_of_one_sign_with_a_short_level_between_are_one_step():
+    """Two -2 % steps 0.2 s apart (ramps of 0.17 and 0.33 s): together a change over 0.7 s, too slow
+    for one light's step, the level between them shorter than a ramp (issue 27: neither was found
+    and the drift fit took the 4 %). Judged as one step of two quick ramps: found, 4 %, removed;
+    a person's change as long, with no level in it, is not (the lamp of the test below)."""
+    rng = np.random.default_rng(10)
+    clean = _wall(rng, _walker())
+    g = (1 - 0.02 * np.clip((t - 4.0) / 0.17, 0, 1)) * (1 - 0.02 * np.clip((t - 4.37) / 0.33, 0, 1))
+    x = clean * g[:, None]
+    fit = C.fit(x, FPS, lines=[10.0], vertical=VERT, part=PART)
+    kinds = {f["kind"]: f for f in fit.findings}
+    assert "drift" not in kinds
+    assert sum(st["size"] for st in kinds["exposure"]["steps"]) == pytest.approx(-0.0396, rel=0.1)
+    # 14 times the walker's signal uncorrected, 4.3 fitted as drift; the size, measured across the
+    # wider gap, is off by 0.1 % here
+    assert _residual(x / (1 + fit.gain), clean) < 0.6
+
+
+@pytest.mark.parametrize("at", [0.3, 8.1])
+def test_a_step_near_the_end_of_the_stretch_is_found(at):
+    """A step with only a quarter of a second of plateau between it and the stretch's end (0.5 s
+    were needed before): found, sized, removed."""
+    rng = np.random.default_rng(7)
+    clean = _wall(rng, _walker())
+    x = clean * (1 + 0.02 * np.clip((t - at) / 0.1, 0, 1))[:, None]
+    fit = C.fit(x, FPS, lines=[10.0], vertical=VERT, part=PART)
+    (f,) = fit.findings
+    (step,) = f["steps"]
+    assert step["time"] == pytest.approx(at + 0.05, abs=0.1) and step["size"] == pytest.approx(0.02, rel=0.1)
+    assert _residual(x / (1 + fit.gain), clean) < 0.1
+
+
+def test_step_sizes_are_the_lights_own_whatever_came_before():
+    """Gains multiply: the second of two 3 % steps is 3 % of the level the first left, so steps are
+    sized (and the drift fitted) in logarithms; the sum of relative sizes would be off by their product."""
+    rng = np.random.default_rng(8)
+    clean = _wall(rng)
+    g = (1 + 0.03 * np.clip((t - 3.0) / 0.1, 0, 1)) * (1 + 0.03 * np.clip((t - 6.0) / 0.1, 0, 1))
+    fit = C.fit(clean * g[:, None], FPS, vertical=VERT, part=PART)
+    (f,) = fit.findings
+    assert [s["size"] for s in f["steps"]] == [pytest.approx(0.03, abs=0.0005)] * 2
+    left = np.median(np.log(clean * g[:, None] / (1 + fit.gain) / clean), axis=1)
+    assert np.std(left) < 1e-4
+
+
+def test_a_small_drift_on_noisy_bins_is_judged_on_groups_of_bins():
+    """A drift of 0.3 % peak to peak on bins six times noisier than the other tests': no single bin
+    can tell it from a person's change, groups of neighbouring bins can; it is removed. The same
+    noise without a drift finds nothing."""
+    rng = np.random.default_rng(9)
+    level = 100 + 20 * np.sin(np.linspace(0, 3, 2 * B))
+    noisy = level[None] * (1 + rng.standard_normal((T, 2 * B)) * 0.003)
+    drift = 1 + 0.0015 * np.sin(2 * np.pi * 0.08 * t + 0.5)
+    fit = C.fit(noisy * drift[:, None], FPS, vertical=VERT, part=PART)
+    assert [f["kind"] for f in fit.findings] == ["drift"]
+    est = np.median(np.log1p(fit.gain), axis=1)
+    truth = np.log(drift) - np.log(drift).mean()
+    assert np.std(est - est.mean() - truth) < 0.2 * np.std(truth)
+    assert C.fit(noisy, FPS, vertical=VERT, part=PART) is None
+
+
 def test_a_slow_uniform_drift_is_removed():
     """Where the wall's bins drift alike: here beside a faint walker (0.1 %). A person whose own slow
     changes are as large as the drift hides it (it is then left in: research/corrections)."""

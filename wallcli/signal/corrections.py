@@ -46,6 +46,7 @@ STEP_MIN = 0.003  # relative size of the smallest exposure step removed
 STEP_SIGMA = 10.0  # and in units of the gain's frame-to-frame noise
 RAMP_S = 0.33  # seconds an exposure step may take
 SPAN_S = 0.5  # seconds averaged on each side of a step
+EDGE_S = 0.17  # or as little as this where the window ends or another step begins
 MAX_STEPS = 4
 DRIFT_DEGREE = 3
 DRIFT_MIN = 0.002  # relative peak-to-peak of the slow gain change removed
@@ -55,6 +56,8 @@ UNEVEN = 0.2  # a bin's change within this fraction of the common one (plus its 
 UNEVEN_DRIFT = 0.4  # the same for drift: a passing shadow bends a bin's slow curve (a cubic) a little
 AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change alike for a step or drift
 AGREE_EACH = 0.5  # and in each profile
+PAIRS = True  # two quick ramps a few tenths apart, with a level between, judged as one step
+AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged on
 
 
 @dataclass(frozen=True)
@@ -153,43 +156,82 @@ def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.nd
     which bin is whose) at least ``AGREE_EACH`` and on average ``AGREE`` of the bins that can tell
     (their noise ``tol`` (K,) under half the change) changed as the common one (...), within
     ``UNEVEN`` of it plus their noise. A change of the light multiplies every bin alike; a person's
-    shadow does not, though it can dim all the rows (or all the columns) of a wall alike."""
+    shadow does not, though it can dim all the rows (or all the columns) of a wall alike.
+
+    Where too few bins can tell (a small change, a noisy profile), neighbouring bins are averaged in
+    pairs (their noise falls by sqrt 2) down to ``AGREE_GROUPS`` groups a profile: a shadow is
+    broad, so it stays uneven over the groups."""
     uneven = UNEVEN if uneven is None else uneven
     part = np.zeros(per_bin.shape[0], int) if part is None else np.asarray(part)
     size = float(np.sqrt(np.mean(np.square(common))))
-    dev = np.sqrt(np.mean(np.square(per_bin - common[None]).reshape(per_bin.shape[0], -1), axis=1))
     fractions = []
     for p in np.unique(part):
         mine = part == p
-        tells = mine & (tol < 0.5 * size)
-        if tells.sum() < max(4, 0.5 * mine.sum()):
-            return False  # too noisy to tell a light's change from a person's
-        fractions.append(float(np.mean(dev[tells] <= uneven * size + tol[tells])))
+        pb = per_bin[mine].reshape(int(mine.sum()), -1)
+        tl = np.asarray(tol, np.float64)[mine]
+        while True:
+            tells = tl < 0.5 * size
+            if tells.sum() >= max(4, 0.5 * tl.size):
+                break
+            if tl.size < 2 * AGREE_GROUPS:
+                return False  # too noisy to tell a light's change from a person's
+            m = tl.size // 2 * 2
+            pb = 0.5 * (pb[0:m:2] + pb[1:m:2])
+            tl = 0.5 * np.hypot(tl[0:m:2], tl[1:m:2])
+        dev = np.sqrt(np.mean(np.square(pb - common.reshape(1, -1)), axis=1))
+        fractions.append(float(np.mean(dev[tells] <= uneven * size + tl[tells])))
     return min(fractions) >= AGREE_EACH and float(np.mean(fractions)) >= AGREE
 
 
-def _local_steps(rel: np.ndarray, j: int, half: int, span: int) -> np.ndarray:
-    """Each series' step at ``j``: a level, a slope and a step fitted to the ``span`` samples on
-    either side of the ramp (the slope takes up a person's slower change across it)."""
+def _masked_means(r: np.ndarray, w: np.ndarray, idx: np.ndarray, half: int, span: int, least: int):
+    """Means of ``r`` over the (up to) ``span`` samples before ``idx - half`` and after ``idx + half``
+    where ``w`` (0/1) counts, the window's ends cutting the spans short; NaN where fewer than ``least``
+    samples count on a side."""
+    t = r.size
+    cs = np.concatenate([[0.0], np.cumsum(r * w)])
+    cn = np.concatenate([[0.0], np.cumsum(w)])
+    b_hi = np.clip(idx - half, 0, t)
+    b_lo = np.clip(idx - half - span, 0, t)
+    a_lo = np.clip(idx + half, 0, t)
+    a_hi = np.clip(idx + half + span, 0, t)
+    nb, na = cn[b_hi] - cn[b_lo], cn[a_hi] - cn[a_lo]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        before = np.where(nb >= least, (cs[b_hi] - cs[b_lo]) / np.maximum(nb, 1), np.nan)
+        after = np.where(na >= least, (cs[a_hi] - cs[a_lo]) / np.maximum(na, 1), np.nan)
+    return before, after
+
+
+def _local_steps(rel: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> np.ndarray:
+    """Each series' step at ``j``: a level, a slope and a step fitted to the (up to) ``span``
+    samples on either side of the ramp that ``w`` counts (the slope takes up a person's slower
+    change across it; other steps' ramps are left out)."""
     t = rel.shape[0]
     idx = np.r_[max(j - half - span, 0):max(j - half, 0), min(j + half, t):min(j + half + span, t)]
+    idx = idx[w[idx] > 0]
     x = (idx - j) / max(span, 1)
     design = np.stack([np.ones_like(x), x, (idx >= j).astype(np.float64)], axis=1)
     coef = _solve(design, rel[idx])
     return coef[2]
 
 
-def _rise(g: np.ndarray, j: int, half: int, span: int) -> int:
+def _rise(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> int:
     """Samples the change of ``g`` around ``j`` takes from 10 % to 90 % of the way between the
-    means of the ``span`` samples before and after it (a light's step is quick; the whole wall
-    dims or brightens as a person moves in front of a lamp over half a second or more)."""
+    means of the (up to) ``span`` samples before and after it that ``w`` counts (a light's step is
+    quick; the whole wall dims or brightens as a person moves in front of a lamp over half a
+    second or more). Samples ``w`` leaves out (other steps' ramps) are read as the nearest level."""
     t = g.size
-    lo, hi = max(j - half - span, 0), min(j + half + span, t)
-    before = g[lo:max(j - half, lo + 1)].mean()
-    after = g[min(j + half, hi - 1):hi].mean()
-    if after == before:
+    before, after = _masked_means(g, w, np.array([j]), half, span, 2)
+    before, after = float(before[0]), float(after[0])
+    if not np.isfinite(before) or not np.isfinite(after) or after == before:
         return t
-    k = np.convolve(g[lo:hi], np.ones(3) / 3, mode="same")
+    lo, hi = max(j - half - span, 0), min(j + half + span, t)
+    seg_g = g[lo:hi].copy()
+    out = w[lo:hi] == 0
+    if out.any():  # another step's ramp: the level on its side of this step
+        pos = np.arange(lo, hi)
+        seg_g[out & (pos < j)] = before
+        seg_g[out & (pos >= j)] = after
+    k = np.convolve(seg_g, np.ones(3) / 3, mode="same")
     f = (k - before) / (after - before)
     seg = f[1:-1]
     above = np.flatnonzero(seg >= 0.9)
@@ -201,13 +243,55 @@ def _rise(g: np.ndarray, j: int, half: int, span: int) -> int:
     return end - start
 
 
+def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[int, int] | None:
+    """(first, end) samples of a change of ``g`` around ``j`` made of two quick ramps (each within
+    ``ramp`` + 3 samples, 10 % to 90 % of the whole) with a level between them (3 samples that move
+    by under 5 % of the change), or None. Two steps of the light a few tenths of a second apart look
+    like one change too slow for a light's; a person's change over as long has no level in it."""
+    t = g.size
+    reach = 2 * ramp
+    before, after = _masked_means(g, w, np.array([j]), reach, span, 2)
+    before, after = float(before[0]), float(after[0])
+    if not np.isfinite(before) or not np.isfinite(after) or after == before:
+        return None
+    lo, hi = max(j - reach - span, 0), min(j + reach + span, t)
+    seg = g[lo:hi].copy()
+    out = w[lo:hi] == 0
+    pos = np.arange(lo, hi)
+    seg[out & (pos < j)] = before
+    seg[out & (pos >= j)] = after
+    f = (np.convolve(seg, np.ones(3) / 3, mode="same") - before) / (after - before)
+    f[0], f[-1] = f[1], f[-2]
+    above = np.flatnonzero(f >= 0.9)
+    if above.size == 0:
+        return None
+    end = int(above[0])
+    below = np.flatnonzero(f[:end] <= 0.1)
+    if below.size == 0:
+        return None
+    start = int(below[-1])
+    for a in range(start + 1, end - 2):
+        if abs(f[a + 2] - f[a]) < 0.05 and 0.15 < f[a] < 0.85:
+            if a - start <= ramp + 3 and end - (a + 2) <= ramp + 3:
+                return lo + start, lo + end + 1
+    return None
+
+
 def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
     """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
-    changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins. Steps
-    are found greedily where the means of the ``SPAN_S`` seconds on either side of a ``RAMP_S``
-    differ by more than STEP_MIN and STEP_SIGMA noise, and kept only where most bins stepped alike
-    (``AGREE``) in every profile (``part`` (K,): which profile each bin is of; a person's shadow
-    can dim all the rows of a wall alike, not also all its columns); so is the drift."""
+    changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins.
+
+    Steps are found one at a time on what the joint fit (the cubic and the steps found so far, each
+    found step's ramp left out) leaves: where the means of the ``SPAN_S`` seconds on either side of
+    a ``RAMP_S`` differ by more than STEP_MIN and STEP_SIGMA noise. A step may lie as close to
+    another as a ramp (the spans reach across the other, which the fit holds), and as close to the
+    window's ends as ``least`` samples of plateau. One is kept only where it is quick (``_rise``;
+    or two quick ramps with a level between them, ``_pair``, taken as one step) and most bins
+    stepped alike (``AGREE``) in every profile (``part`` (K,): which profile each bin
+    is of; a person's shadow can dim all the rows of a wall alike, not also all its columns); so is
+    the drift. Each step's size is the median of the bins' own (a shadow moves a fit of the median
+    over the bins), each bin's fitted with the other steps taken out (close steps are sized again
+    once all are found). Works on logarithms of the levels (:func:`fit`): gains add."""
     t = rel.shape[0]
     g = _robust_gain(rel)
     basis = _legendre(t, DRIFT_DEGREE)
@@ -215,66 +299,99 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     noise = 1.4826 * np.median(np.abs(dg - np.median(dg))) / np.sqrt(2.0)
     db = np.diff(rel, axis=0)
     sigma = 1.4826 * np.median(np.abs(db - np.median(db, axis=0)), axis=0) / np.sqrt(2.0)  # (K,) per bin
-    found: list[int] = []
-    sizes: list[float] = []  # each step's size: the median of the bins' own (a shadow moves the joint fit's)
-    blocked: list[int] = []
-    cols = [basis]
     ramp = max(2, int(round(RAMP_S * rate)))
     span = max(4, int(round(SPAN_S * rate)))
     half = ramp // 2
+    least = max(3, int(round(EDGE_S * rate)))  # the shortest plateau a step is measured on
+    thr = max(STEP_MIN, STEP_SIGMA * noise)
+    w = np.ones(t)  # 0 on found steps' ramps, which the steps' model (a jump) does not describe
+    found: list[int] = []
+    sizes: list[float] = []
+    halves: list[int] = []  # each step's half-width of ramp (two quick ramps together: wider)
+    blocked: list[int] = []
+    n = np.arange(t)
+
+    def stepped(skip: int = -1) -> np.ndarray:
+        return sum((s * (n >= j) for i, (j, s) in enumerate(zip(found, sizes)) if i != skip), np.zeros(t))
+
+    def counts(j: int) -> tuple[float, float]:
+        nb = w[max(j - half - span, 0):max(j - half, 0)].sum()
+        na = w[min(j + half, t):min(j + half + span, t)].sum()
+        return float(nb), float(na)
+
+    idx = np.arange(half + least, t - half - least + 1)
     for _ in range(2 * MAX_STEPS):
-        if len(found) >= MAX_STEPS:
+        if len(found) >= MAX_STEPS or idx.size == 0:
             break
-        design = np.concatenate(cols, axis=1)
-        coef = _solve(design, g)
+        design = np.concatenate([basis] + [(n >= j).astype(np.float64)[:, None] for j in found], axis=1)
+        keep = w > 0
+        coef = _solve(design[keep], g[keep])
         r = g - design @ coef
-        c = np.concatenate([[0.0], np.cumsum(r)])
-        idx = np.arange(span + half, t - span - half)
-        if idx.size == 0:
-            break
-        after = (c[idx + half + span] - c[idx + half]) / span
-        before = (c[idx - half] - c[idx - half - span]) / span
-        d = after - before
-        for j in found + blocked:  # one step is looked at once
+        before, after = _masked_means(r, w, idx, half, span, least)
+        d = np.nan_to_num(after - before)
+        for j in found:
+            d[np.abs(idx - j) < ramp] = 0.0
+        for j in blocked:  # one change is looked at once
             d[np.abs(idx - j) < ramp + span] = 0.0
         k = int(np.argmax(np.abs(d)))
-        if abs(d[k]) < max(STEP_MIN, STEP_SIGMA * noise):
+        if abs(d[k]) < thr:
             break
         # the plateau of d is a ramp wide: the step is where the adjacent means differ most
-        cand = np.arange(max(int(idx[k]) - half, span), min(int(idx[k]) + half + 1, t - span + 1))
-        j = int(idx[k])
-        if cand.size:
-            adj = (c[cand + span] - c[cand]) - (c[cand] - c[cand - span])
-            j = int(cand[np.argmax(np.abs(adj))])
-        per_bin = _local_steps(rel, j, half, span)
-        common = np.array([np.median(per_bin)])
-        tol = 4 * sigma * np.sqrt(2.0 / span)
-        if (abs(common[0]) >= max(STEP_MIN, STEP_SIGMA * noise) and _rise(g, j, half, span) <= ramp + 3
-                and _agree(per_bin[:, None], common, tol, part)):
+        cand = np.arange(max(int(idx[k]) - half, 1), min(int(idx[k]) + half + 1, t - 1))
+        b2, a2 = _masked_means(r, w, cand, 0, span, least)
+        adj = np.nan_to_num(a2 - b2)
+        j = int(cand[np.argmax(np.abs(adj))]) if np.any(adj) else int(idx[k])
+        nb, na = counts(j)
+        ok = min(nb, na) >= 2
+        if ok:
+            others = stepped()
+            hj = half
+            if _rise(g - others, w, j, half, span) > ramp + 3:
+                two = _pair(g - others, w, j, ramp, span) if PAIRS else None
+                hj = max(j - two[0], two[1] - j) if two is not None else -1
+            ok = hj >= 0
+            if ok:
+                per_bin = _local_steps(rel - others[:, None], w, j, hj, span)
+                common = np.array([np.median(per_bin)])
+                tol = 4 * sigma * np.sqrt(1.0 / nb + 1.0 / na)
+                ok = abs(common[0]) >= thr and _agree(per_bin[:, None], common, tol, part)
+        if ok:
             found.append(j)
             sizes.append(float(common[0]))
-            cols.append((np.arange(t) >= j).astype(np.float64)[:, None])
+            halves.append(hj)
+            w[max(j - hj - 1, 0):min(j + hj + 1, t)] = 0.0
         else:
             blocked.append(j)  # uneven along the wall: someone's shadow, kept
-    stepped = sum((size * (np.arange(t) >= j) for j, size in zip(found, sizes)), np.zeros(t))
+    for _ in range(2 if len(found) > 1 else 0):
+        # a step whose spans reached across another one, found after it, was sized with that one in
+        # them: size it again with the others' sizes taken out
+        for i, j in enumerate(found):
+            if any(abs(j - k) < halves[i] + span for k in found if k != j):
+                sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
+    steps_g = stepped()
+    keep = w > 0
     nb = basis.shape[1]
-    coef = _solve(basis, g - stepped)
+    coef = _solve(basis[keep], (g - steps_g)[keep])
     drift = basis[:, 1:] @ coef[1:]
     ptp = float(drift.max() - drift.min())
     if ptp >= DRIFT_MIN:
-        cb = _solve(basis, rel - stepped[:, None])
+        cb = _solve(basis[keep], (rel - steps_g[:, None])[keep])
         per_bin = (basis[:, 1:] @ cb[1:nb]).T  # (K, T)
-        tol = 3 * sigma * np.sqrt((nb - 1) / t)
+        tol = 3 * sigma * np.sqrt((nb - 1) / keep.sum())
         if DRIFT_AGREE and not _agree(per_bin, drift, tol, part, UNEVEN_DRIFT):
             ptp = 0.0
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
-    steps = []
-    for j, size in zip(found, sizes):
-        model = model + size * (np.arange(t) >= j)
-        steps.append((j, float(size)))
-    for j, _ in steps:  # within a ramp the step's shape is what was measured, not a jump
-        lo, hi = max(j - half - 1, 0), min(j + half + 1, t)
-        model[lo:hi] = g[lo:hi] - np.median((g - model)[max(lo - span, 0):min(hi + span, t)])
+    model = model + steps_g
+    order = sorted(zip(found, halves))
+    for j, hj in order:  # within a ramp the step's shape is what was measured, not a jump
+        lo, hi = max(j - hj - 1, 0), min(j + hj + 1, t)
+        around = np.arange(max(lo - span, 0), min(hi + span, t))
+        around = around[keep[around]]
+        model[lo:hi] = g[lo:hi] - (np.median((g - model)[around]) if around.size else 0.0)
+    # each step's size as the model has it: the change across its ramp (where two ramps touch, the
+    # level between them is only seen there, not in the fitted jumps)
+    steps = [(j, float(np.mean(model[min(j + hj + 1, t - 1):min(j + hj + 3, t)])
+                        - np.mean(model[max(j - hj - 3, 0):max(j - hj - 1, 1)]))) for j, hj in order]
     return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
 
 
@@ -329,15 +446,19 @@ def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options
                     found["bands"] = round(turn, 2)  # cycles of the bands over the profile's height
             findings.append(found)
     if options.exposure:
-        model, steps, drift = _steps_and_drift(rel[:, ok], rate, None if part is None else np.asarray(part)[ok])
+        # in logarithms the light's gains add (two steps of 2 % are 2 % each, whatever came before),
+        # so the steps and the drift are fitted and sized alike wherever they fall in the stretch
+        lrel = np.log(np.maximum(1.0 + rel[:, ok], 1e-9))
+        lrel -= lrel.mean(axis=0)
+        model, steps, drift = _steps_and_drift(lrel, rate, None if part is None else np.asarray(part)[ok])
         model = model - np.mean(model)
         if steps or drift:
-            gain = (1.0 + gain) * (1.0 + model[:, None]) - 1.0
+            gain = (1.0 + gain) * np.exp(model)[:, None] - 1.0
             if steps:
-                findings.append({"kind": "exposure", "steps": [{"time": round(t0 + j / rate, 3), "size": round(s, 5)}
-                                                               for j, s in steps]})
+                findings.append({"kind": "exposure", "steps": [
+                    {"time": round(t0 + j / rate, 3), "size": round(float(np.expm1(s)), 5)} for j, s in steps]})
             if drift:
-                findings.append({"kind": "drift", "amplitude": round(drift / 2, 5)})
+                findings.append({"kind": "drift", "amplitude": round(float(np.expm1(drift / 2)), 5)})
     if not findings:
         return None
     return Fit(gain, findings)
