@@ -214,26 +214,34 @@ def _local_steps(rel: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -
     return coef[2]
 
 
+def _fraction_of_change(g: np.ndarray, w: np.ndarray, j: int, reach: int, span: int):
+    """(f, lo): ``g`` from ``lo`` to ``reach`` + ``span`` samples either side of ``j`` as the
+    fraction of the way from the mean level before the change to the mean after it (a 3-sample
+    running mean), or None where the levels are not both there or do not differ. Samples ``w``
+    leaves out (other steps' ramps) are read as the level on their side of ``j``."""
+    before, after = _masked_means(g, w, np.array([j]), reach, span, 2)
+    before, after = float(before[0]), float(after[0])
+    if not np.isfinite(before) or not np.isfinite(after) or after == before:
+        return None
+    lo, hi = max(j - reach - span, 0), min(j + reach + span, g.size)
+    seg = g[lo:hi].copy()
+    out = w[lo:hi] == 0
+    pos = np.arange(lo, hi)
+    seg[out & (pos < j)] = before
+    seg[out & (pos >= j)] = after
+    return (np.convolve(seg, np.ones(3) / 3, mode="same") - before) / (after - before), lo
+
+
 def _rise(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> int:
     """Samples the change of ``g`` around ``j`` takes from 10 % to 90 % of the way between the
     means of the (up to) ``span`` samples before and after it that ``w`` counts (a light's step is
     quick; the whole wall dims or brightens as a person moves in front of a lamp over half a
     second or more). Samples ``w`` leaves out (other steps' ramps) are read as the nearest level."""
     t = g.size
-    before, after = _masked_means(g, w, np.array([j]), half, span, 2)
-    before, after = float(before[0]), float(after[0])
-    if not np.isfinite(before) or not np.isfinite(after) or after == before:
+    change = _fraction_of_change(g, w, j, half, span)
+    if change is None:
         return t
-    lo, hi = max(j - half - span, 0), min(j + half + span, t)
-    seg_g = g[lo:hi].copy()
-    out = w[lo:hi] == 0
-    if out.any():  # another step's ramp: the level on its side of this step
-        pos = np.arange(lo, hi)
-        seg_g[out & (pos < j)] = before
-        seg_g[out & (pos >= j)] = after
-    k = np.convolve(seg_g, np.ones(3) / 3, mode="same")
-    f = (k - before) / (after - before)
-    seg = f[1:-1]
+    seg = change[0][1:-1]
     above = np.flatnonzero(seg >= 0.9)
     if above.size == 0:
         return t
@@ -248,19 +256,10 @@ def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[i
     ``ramp`` + 3 samples, 10 % to 90 % of the whole) with a level between them (3 samples that move
     by under 5 % of the change), or None. Two steps of the light a few tenths of a second apart look
     like one change too slow for a light's; a person's change over as long has no level in it."""
-    t = g.size
-    reach = 2 * ramp
-    before, after = _masked_means(g, w, np.array([j]), reach, span, 2)
-    before, after = float(before[0]), float(after[0])
-    if not np.isfinite(before) or not np.isfinite(after) or after == before:
+    change = _fraction_of_change(g, w, j, 2 * ramp, span)
+    if change is None:
         return None
-    lo, hi = max(j - reach - span, 0), min(j + reach + span, t)
-    seg = g[lo:hi].copy()
-    out = w[lo:hi] == 0
-    pos = np.arange(lo, hi)
-    seg[out & (pos < j)] = before
-    seg[out & (pos >= j)] = after
-    f = (np.convolve(seg, np.ones(3) / 3, mode="same") - before) / (after - before)
+    f, lo = change
     f[0], f[-1] = f[1], f[-2]
     above = np.flatnonzero(f >= 0.9)
     if above.size == 0:
