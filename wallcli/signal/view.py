@@ -312,7 +312,7 @@ class ViewCheck:
 
         small, w = _grey(planes, self.roi, MAX_SIDE)
         self._scale = 1.0 / (small.shape[1] / w)
-        self._full_small = small.shape
+        full = small.shape
         small = _whole_blocks(small)
         bh, bw = (n // _block_side(small.shape) for n in small.shape)
         blocks = cv2.resize(small, (bw, bh), interpolation=cv2.INTER_AREA)
@@ -322,7 +322,7 @@ class ViewCheck:
             clipped = np.zeros(blocks.shape, bool)
         dark = (blocks < DARK) & ~clipped
         ok = ~(clipped | dark)
-        self._note_bad(~ok, small.shape)
+        self._note_bad(~ok, full, small.shape)
         usable = float(ok.mean())
         self.min_usable = min(self.min_usable, usable)
         flags = set()
@@ -344,14 +344,14 @@ class ViewCheck:
         for kind in flags:
             self._mark(kind, t)
 
-    def _note_bad(self, bad: np.ndarray, cropped: tuple[int, int]) -> None:
+    def _note_bad(self, bad: np.ndarray, full: tuple[int, int], cropped: tuple[int, int]) -> None:
         """OR ``bad`` (per block) into the clip's map, and remember where the blocks lie: the
         block grid tiles the centre of the downscaled frame (see _whole_blocks)."""
         if self._bad is None or self._bad.shape != bad.shape:
             self._bad = np.zeros(bad.shape, bool)
             side = _block_side(cropped)
             x0, y0 = (self.roi[0], self.roi[1]) if self.roi is not None else (0, 0)
-            sh, sw = self._full_small
+            sh, sw = full
             self._bad_geometry = (x0, y0, side, (sh - cropped[0]) // 2, (sw - cropped[1]) // 2, self._scale)
         self._bad |= bad
 
