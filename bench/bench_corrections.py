@@ -1,6 +1,6 @@
-"""What each correction of issue 27 (aliased mains flicker, exposure steps and drift) costs in
-throughput: each command with each correction on, against the same command with both off, in
-one run.
+"""What each correction of issue 27 (aliased mains flicker, exposure steps and drift, camera shake)
+costs in throughput: each command with each correction on, against the same command with all
+off, in one run.
 
     .venv/bin/python bench/bench_corrections.py [--frames 600] [--repeat 3]
 
@@ -28,12 +28,17 @@ sys.path.insert(0, str(HERE))
 from bench_speed import measure  # noqa: E402
 from clips import OUT, clip_1080p, make_clip  # noqa: E402
 
-VARIANTS = {  # name: extra options
-    "off": ("--no-deflicker", "--no-exposure"),
-    "deflicker": ("--no-exposure",),
-    "exposure": ("--no-deflicker",),
-    "both (default)": (),
+VARIANTS = {  # name: extra options (snr has no shake correction: --no-shake is dropped for it)
+    "off": ("--no-deflicker", "--no-exposure", "--no-shake"),
+    "deflicker": ("--no-exposure", "--no-shake"),
+    "exposure": ("--no-deflicker", "--no-shake"),
+    "shake": ("--no-deflicker", "--no-exposure"),
+    "all (default)": (),
 }
+
+
+def _options(cmd: str, extra: tuple) -> tuple:
+    return tuple(o for o in extra if cmd != "snr" or o != "--no-shake")
 
 
 def main() -> None:
@@ -57,7 +62,7 @@ def main() -> None:
             runs: dict[str, list[dict]] = {v: [] for v in VARIANTS}
             for _ in range(args.repeat):
                 for v, extra in VARIANTS.items():
-                    runs[v].append(measure("wallcli", cmd, str(clip), "--json", *extra))
+                    runs[v].append(measure("wallcli", cmd, str(clip), "--json", *_options(cmd, extra)))
             best = {v: min(r, key=lambda x: x["seconds"]) for v, r in runs.items()}
             cpu = {v: min(x["cpu_seconds"] for x in r) for v, r in runs.items()}
             for v in VARIANTS:
@@ -123,6 +128,19 @@ def micro(clip: Path) -> None:
             acc.update(p)
         acc.result()
 
+    # the shake's registration: every frame's shift on both axes (count reads only the horizontal
+    # profile, so its luma rows are summed for it alone)
+    from wallcli.signal.blocks import RgbProjector
+
+    def project(register: bool, vertical: bool):
+        proj = RgbProjector(roi, 64, vertical=vertical, register=register)
+        for p in frames:
+            proj(p)
+
+    for vertical, label in ((False, "count (horizontal)"), (True, "activity (both)")):
+        off = 1e3 * _best(lambda: project(False, vertical), 5) / n
+        on = 1e3 * _best(lambda: project(True, vertical), 5) / n
+        print(f"| profiles per 1080p frame, {label} | {off:.2f} ms | registered: {on:.2f} ms | ratio {off / on:.2f} |")
     ms = {name: 1e3 * _best(lambda o=o: snr(o), 5) / n for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False)),
                                                                         ("exposure", corr.Options(False, True)), ("both", corr.Options()))}
     print(f"| snr, per 1080p frame | {ms['off']:.2f} ms | {ms['deflicker']:.2f} ms | {ms['exposure']:.2f} ms | "

@@ -39,7 +39,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     task: a video either has every answer asked for or none.
     """
     from wallcli.errors import WallcliError
-    from wallcli.infer.classify import WindowClassifier, with_view
+    from wallcli.infer.classify import WindowClassifier, stream_row, with_view
     from wallcli.infer.stream import RowStream
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
@@ -74,9 +74,10 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections, native_fps=float(info.fps))
                        for m in used]
         if classifiers:
-            vertical = any("vertical" in m.input_names for m in used) or corrections.any
-            rows = RowStream(tee, bins=used[0].bins, fps=used[0].fps, vertical=vertical)
+            vertical = any("vertical" in m.input_names for m in used) or corrections.light
+            rows = RowStream(tee, bins=used[0].bins, fps=used[0].fps, vertical=vertical, register=corrections.shake)
             for t, row in rows:
+                row = stream_row(row, rows)
                 for c in classifiers:
                     c.push(t, row, rows.ref)
         else:

@@ -72,7 +72,7 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
              log: Callable[[str], None] = lambda m: None,
              on_start: Callable[[int, int], None] = lambda todo, skipped: None,
              on_line: Callable[[dict], None] = lambda line: None, debug: bool = False,
-             deflicker: bool = True, exposure: bool = True) -> dict[str, Any]:
+             deflicker: bool = True, exposure: bool = True, shake: bool = True) -> dict[str, Any]:
     """Scan every video named by ``inputs`` into ``output``; the summary of the run.
 
     ``on_start(todo, skipped)`` once the work is known; ``on_line(line)`` after each line is
@@ -102,7 +102,7 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
                 "--force redoes them")
         on_start(len(todo), skipped)
         config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity(),
-                            deflicker=deflicker, exposure=exposure)
+                            deflicker=deflicker, exposure=exposure, shake=shake)
         results.start(kept)
         t0 = time.perf_counter()
         if todo:

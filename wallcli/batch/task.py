@@ -27,6 +27,7 @@ class ScanConfig:
     onnx_threads: int = 1
     deflicker: bool = True  # the corrections (wallcli.signal.corrections) run on every video
     exposure: bool = True
+    shake: bool = True
     # what the client runs (identity()); a worker that differs answers with an error line
     expected: dict = field(default_factory=dict)
 
@@ -154,7 +155,7 @@ def scan_video(source: str, config: ScanConfig) -> dict[str, Any]:
             from wallcli.signal.corrections import Options
 
             return analyse(source, config.tasks, models, decoder_threads=config.decoder_threads, on_frame=beat,
-                           corrections=Options(config.deflicker, config.exposure))
+                           corrections=Options(config.deflicker, config.exposure, config.shake))
 
         out = run_with_watchdog(job, config.timeout)
     except (WallcliError, Stalled, OSError, MemoryError) as exc:

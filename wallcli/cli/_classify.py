@@ -11,6 +11,7 @@ from typing import Optional
 import typer
 
 from wallcli.cli.common import (ROI_HELP, corrections_of, deflicker_option, exposure_option, force_help, input_argument,
+                                shake_option,
                                 number_option, parse_roi, refuse_view, strict_option, threads_option)
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
@@ -28,15 +29,17 @@ INPUT_ARG = input_argument(INPUT_HELP)
 STRICT_OPT = strict_option()
 NO_DEFLICKER_OPT = deflicker_option()
 NO_EXPOSURE_OPT = exposure_option()
+NO_SHAKE_OPT = shake_option()
 
 
 def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
-        strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False) -> None:
+        strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
+        no_shake: bool = False) -> None:
     from wallcli.errors import UsageError
 
     roi_t = parse_roi(roi)
-    fixes = corrections_of(no_deflicker, no_exposure)
+    fixes = corrections_of(no_deflicker, no_exposure, no_shake)
     if follow and plot is not None:
         raise UsageError("--plot needs the whole clip; it cannot be combined with --follow")
     if follow and str(input).lower().endswith(".npz"):

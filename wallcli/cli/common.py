@@ -138,6 +138,10 @@ DEFLICKER_HELP = ("Leave aliased mains flicker in. By default a narrow line wher
 EXPOSURE_HELP = ("Leave auto-exposure and gain steps and slow light drift in. By default whole-frame steps and "
                  "drift slower than about 8 s are found, divided out before analysis, and listed under "
                  "'corrections' in the JSON.")
+SHAKE_HELP = ("Leave camera shake in. By default each frame's sub-pixel shift is measured on the wall's "
+              "own features and, where the shifts explain the space-time plots, each bin's response to "
+              "them is fitted and removed before count and activity (listed as 'shake' under "
+              "'corrections'). Motion the view check refuses is not made usable by it.")
 
 
 def deflicker_option():
@@ -148,8 +152,12 @@ def exposure_option():
     return typer.Option(False, "--no-exposure", help=EXPOSURE_HELP)
 
 
-def corrections_of(no_deflicker: bool, no_exposure: bool):
-    """The corrections to run (wallcli.signal.corrections.Options) from the two options."""
+def shake_option():
+    return typer.Option(False, "--no-shake", help=SHAKE_HELP)
+
+
+def corrections_of(no_deflicker: bool, no_exposure: bool, no_shake: bool = False):
+    """The corrections to run (wallcli.signal.corrections.Options) from the --no-* options."""
     from wallcli.signal.corrections import Options
 
-    return Options(deflicker=not no_deflicker, exposure=not no_exposure)
+    return Options(deflicker=not no_deflicker, exposure=not no_exposure, shake=not no_shake)

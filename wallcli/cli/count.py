@@ -5,7 +5,7 @@ from pathlib import Path
 from typing import Optional
 
 from wallcli.cli._classify import (FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
-                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, run)
+                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT, run)
 
 
 def count(
@@ -21,6 +21,7 @@ def count(
     strict: bool = STRICT_OPT,
     no_deflicker: bool = NO_DEFLICKER_OPT,
     no_exposure: bool = NO_EXPOSURE_OPT,
+    no_shake: bool = NO_SHAKE_OPT,
 ) -> None:
     """Count the people (0, 1 or 2) moving out of view, from the light on a blank wall.
 
@@ -38,4 +39,4 @@ def count(
     """
     run("count", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,
-        no_deflicker=no_deflicker, no_exposure=no_exposure)
+        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake)

@@ -6,7 +6,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (MAX_THREADS, ROI_HELP, corrections_of, deflicker_option, exposure_option, force_help,
+from wallcli.cli.common import (MAX_THREADS, ROI_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 number_option, strict_option)
 
 PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
@@ -33,6 +33,7 @@ def evaluate(
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
+    no_shake: bool = shake_option(),
 ) -> None:
     """Score a model on labelled clips: the check to run before relying on it for a room.
 
@@ -82,7 +83,7 @@ def evaluate(
     # delayed: on a small folder a bar would only flash; on a large one it shows the minutes left
     with progress(f"evaluate {task}", len(plan.kept), delay=PROGRESS_DELAY) as advance:
         result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan,
-                                 corrections=corrections_of(no_deflicker, no_exposure))
+                                 corrections=corrections_of(no_deflicker, no_exposure, no_shake))
     if plot is not None:
         from wallcli.plots.reliability import save_reliability_png
 

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, force_help,
+from wallcli.cli.common import (ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 parse_roi, refuse_view, strict_option, threads_option)
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
@@ -25,6 +25,7 @@ def report(
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
+    no_shake: bool = shake_option(),
 ) -> None:
     """Write one HTML page that opens offline in any browser and can be handed over as it is.
 
@@ -79,7 +80,7 @@ def report(
         models = load_models(count_model, activity_model)
         with progress("report", None) as advance:
             analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance,
-                               corrections=corrections_of(no_deflicker, no_exposure))
+                               corrections=corrections_of(no_deflicker, no_exposure, no_shake))
         if strict:
             refuse_view(input, analysis.view)
         for w in analysis.warnings:

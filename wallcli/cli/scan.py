@@ -7,7 +7,8 @@ from typing import List, Optional
 
 import typer
 
-from wallcli.cli.common import MAX_THREADS, deflicker_option, exposure_option, number_option, strict_option
+from wallcli.cli.common import (MAX_THREADS, deflicker_option, exposure_option, number_option, shake_option,
+                                strict_option)
 
 
 def scan(
@@ -37,6 +38,7 @@ def scan(
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
+    no_shake: bool = shake_option(),
 ) -> None:
     """Analyse many videos into one results file: one line per video, as each finishes.
 
@@ -88,7 +90,7 @@ def scan(
         summary = run_scan(inputs, output, tasks=tasks, workers=workers, scheduler=scheduler, globs=glob,
                            force=force, windows=windows, timeout=timeout, encode=to_json, log=lambda m: log(m, wrap=False),
                            on_start=bar.start, on_line=on_line, debug=debug,
-                           deflicker=not no_deflicker, exposure=not no_exposure)
+                           deflicker=not no_deflicker, exposure=not no_exposure, shake=not no_shake)
     from wallcli.wording import plural
 
     log(f"scan: {plural(summary['videos'], 'video')}: {summary['ok']} done, {summary['failed']} failed, "

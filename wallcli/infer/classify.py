@@ -88,21 +88,23 @@ def native_fps(time) -> float | None:
     return 1.0 / d if d > 0 else None
 
 
-def _corrected(model, wins: dict, offsets: dict, native, options, starts=None):
+def _corrected(model, wins: dict, offsets: dict, native, options, starts=None, shifts=None):
     """(windows, findings per window): ``wins`` {name: (n, bins, W, 3)} with the whole-frame light
-    nuisances of :mod:`wallcli.signal.corrections` divided out (all of a window's parts together)."""
+    nuisances of :mod:`wallcli.signal.corrections` divided out (all of a window's parts together),
+    and the camera's shake regressed out where ``shifts`` (n, W, 2) were measured."""
     names = list(wins)
     if not options.any:
         return wins, [[] for _ in range(next(iter(wins.values())).shape[0])]
     parts, found = corr.correct_windows([wins[n] for n in names], [offsets[n] for n in names], model.fps,
                                         lines=corr.mains_lines(native, model.fps), options=options, starts=starts,
-                                        vertical_index=names.index("vertical") if "vertical" in names else None)
+                                        vertical_index=names.index("vertical") if "vertical" in names else None,
+                                        shifts=shifts)
     return dict(zip(names, parts)), found
 
 
 def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
-    plots, grid = resampled_plots(model, plot, both=corrections.any)
+    plots, grid = resampled_plots(model, plot, both=corrections.light)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     frames = len(grid) if plot.frames >= 2 else plot.frames
@@ -127,16 +129,28 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
 def _predict_window(model, win: np.ndarray, ref: np.ndarray, *, start: float = 0.0, native=None,
                     options: corr.Options = corr.Options()) -> tuple[np.ndarray, float, list]:
     """(probabilities, signal dB, corrections found) of one (2*bins, window, 3) window, horizontal
-    rows first; ``ref`` (2*bins, 3) is the level the stream's rows are relative to (RowStream.ref)."""
+    rows first; ``ref`` (2*bins, 3) is the level the stream's rows are relative to (RowStream.ref).
+    A window of 2*bins + 1 rows carries each sample's measured camera shift (dx, dy) in its last
+    (:func:`stream_row`)."""
     b = model.bins
-    parts = {"horizontal": win[:b], "vertical": win[b:]}
+    shifts = win[2 * b, :, :2][None].astype(np.float64) if win.shape[0] > 2 * b else None
+    parts = {"horizontal": win[:b], "vertical": win[b:2 * b]}
     refs = {"horizontal": ref[None, :b], "vertical": ref[None, b:]}
     # the corrections read both profiles when the stream has them (a light's change is alike along
     # both; rolling-shutter bands run down the vertical one), whatever the model reads
     use = [n for n in ("horizontal", "vertical") if n in model.input_names or (options.any and np.any(parts[n]))]
-    wins, found = _corrected(model, {n: parts[n][None] for n in use}, refs, native, options, starts=[start])
+    wins, found = _corrected(model, {n: parts[n][None] for n in use}, refs, native, options, starts=[start],
+                             shifts=shifts)
     probs = model.predict({n: model.normalize(wins[n], refs[n]) for n in model.input_names})[0]
     return probs, float(window_signal_db([(wins[n], refs[n]) for n in model.input_names])[0]), found[0]
+
+
+def stream_row(row: np.ndarray, rows) -> np.ndarray:
+    """A :class:`RowStream` row as the windows keep it: with the stream's measured shift (dx, dy)
+    as one more row when it registers its frames, for the corrections' shake regression."""
+    if rows.shift is None:
+        return row
+    return np.concatenate([row, np.array([[rows.shift[0], rows.shift[1], 0.0]], np.float32)])
 
 
 class WindowClassifier:
@@ -227,11 +241,12 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
         rows = RowStream(FrameTee(reader, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
-                         progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.any)
+                         progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.light,
+                         register=corrections.shake)
         for t, row in rows:
             if thumb is not None:
                 thumb.push(t, row)
-            classifier.push(t, row, rows.ref)
+            classifier.push(t, stream_row(row, rows), rows.ref)
     result = with_view(classifier.result(str(source)), check)
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
@@ -286,9 +301,9 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
         rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps,
-                         vertical="vertical" in model.input_names or corrections.any)
+                         vertical="vertical" in model.input_names or corrections.light, register=corrections.shake)
         for t, row in rows:
-            done = windower.push(t, row)
+            done = windower.push(t, stream_row(row, rows))
             if done is not None:
                 p, db, found = _predict_window(model, done[2], rows.ref, start=done[0], native=float(reader.info.fps),
                                                options=corrections)

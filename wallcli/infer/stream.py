@@ -23,10 +23,15 @@ class RowStream:
     """
 
     def __init__(self, reader, *, roi=None, bins: int = 64, fps: float = 30.0,
-                 progress: Callable[[int], None] | None = None, vertical: bool = True, stabilize: bool = False):
+                 progress: Callable[[int], None] | None = None, vertical: bool = True, stabilize: bool = False,
+                 register: bool = False):
         self.reader, self.requested, self.bins, self.fps, self.progress = reader, roi, int(bins), fps, progress
         self.vertical = vertical
         self.stabilize = stabilize
+        # register: measure each frame's sub-pixel shift (both axes); ``shift`` is then the one of
+        # the row last yielded, resampled with it, for the corrections' shake regression
+        self.register = register
+        self.shift = None
         self.shifts = None  # what stabilisation found, once frames are read (a ShiftLog)
         self.roi = None
         self.frame_size = None
@@ -45,7 +50,7 @@ class RowStream:
                 # streams), as in compute_stplot
                 self.frame_size = [frame.planes.width, frame.planes.height]
                 self.roi = check_roi(self.requested, *self.frame_size)
-                reduce = RowReducer(self.roi, self.bins, self.vertical, self.stabilize)
+                reduce = RowReducer(self.roi, self.bins, self.vertical, self.stabilize, self.register)
                 self.shifts = reduce.shifts
             row = np.concatenate(reduce(frame.planes))
             if self.ref is None:
@@ -53,7 +58,17 @@ class RowStream:
             self.frames += 1
             if self.progress:
                 self.progress(1)
-            yield from resampler.push(frame.time, (row - self.ref).astype(np.float32))
+            rel = (row - self.ref).astype(np.float32)
+            if not self.register:
+                yield from resampler.push(frame.time, rel)
+                continue
+            # the shift travels as one more row through the resampler, so it is interpolated
+            # to the same grid times as the profiles it explains
+            dx, dy = reduce.shift
+            ext = np.concatenate([rel, np.array([[dx, dy, 0.0]], np.float32)])
+            for t, r in resampler.push(frame.time, ext):
+                self.shift = (float(r[-1, 0]), float(r[-1, 1]))
+                yield t, r[:-1]
 
 
 class PlotThumbnail:

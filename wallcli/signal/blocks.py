@@ -255,7 +255,7 @@ class _FusedProjection:
     edges give every bin mean (the per-plane path spent as long on six small binning steps as
     on the reductions). Returns (2 or 1, bins, planes) means; exact as :class:`ProjectionPlan`."""
 
-    def __init__(self, rects, rows: bool, stabilize: bool = False, sub=(0, 0)):
+    def __init__(self, rects, rows: bool, stabilize: bool = False, sub=(0, 0), register: bool = False):
         import cv2
 
         self._reduce, self._sum = cv2.reduce, cv2.REDUCE_SUM
@@ -294,9 +294,14 @@ class _FusedProjection:
         self._per_px = np.asarray(per_px)  # (edges, 2): how far each edge moves per (dx, dy) pixel
         self._bounds = np.asarray(bounds, np.float64)
         self.stabilize = bool(stabilize)
-        self._shift_x = LineShift() if stabilize else None
-        self._shift_y = LineShift() if stabilize and rows else None
-        self.shift = (0.0, 0.0)  # the last frame's (dx, dy) in luma pixels, applied before binning
+        # register: measure the shift on both axes without re-binning (the corrections regress the
+        # profiles on it, shake.py); a horizontal-only projection then sums the luma rows too
+        self.register = bool(register) or self.stabilize
+        self._shift_x = LineShift() if self.register else None
+        self._shift_y = LineShift() if self.register and (rows or register) else None
+        r0, r1, c0, c1 = rects[0][:4]
+        self._luma_rows = np.empty((r1 - r0, 1), np.float32) if self._shift_y is not None and not rows else None
+        self.shift = (0.0, 0.0)  # the last frame's (dx, dy) in luma pixels
         self.shape = (len(axes), len(rects), len(rects[0][5]) - 1)
 
     def __call__(self, planes) -> np.ndarray:
@@ -304,11 +309,17 @@ class _FusedProjection:
             r0, r1, c0, c1 = self.rects[p][:4]
             self._reduce(planes[p][r0:r1, c0:c1], axis, self._sum, dst=dst, dtype=5)  # 5: CV_32F
         np.cumsum(self.buf, dtype=np.float64, out=self._run[1:])
-        if self.stabilize:
+        if self.register:
             dx = self._shift_x(self.lines[(0, 0)])
-            dy = self._shift_y(self.lines[(0, 1)]) if self._shift_y is not None else 0.0
+            dy = 0.0
+            if self._luma_rows is not None:
+                r0, r1, c0, c1 = self.rects[0][:4]
+                self._reduce(planes[0][r0:r1, c0:c1], 1, self._sum, dst=self._luma_rows, dtype=5)
+                dy = self._shift_y(self._luma_rows[:, 0])
+            elif self._shift_y is not None:
+                dy = self._shift_y(self.lines[(0, 1)])
             self.shift = (dx, dy)
-            if dx or dy:
+            if self.stabilize and (dx or dy):
                 return self._shifted(dx, dy)
         at = np.interp(self.at, self._grid, self._run)
         means = (at[self.lo + 1] - at[self.lo]) * self.scale
@@ -374,12 +385,14 @@ class RgbProjector:
     horizontal plot (count) saves half of the per-frame reductions.
     """
 
-    def __init__(self, roi: Roi, bins: int, vertical: bool = True, stabilize: bool = False):
+    def __init__(self, roi: Roi, bins: int, vertical: bool = True, stabilize: bool = False, register: bool = False):
         import cv2
 
         self._cv2 = cv2
         self.vertical = bool(vertical)
         self.stabilize = bool(stabilize)
+        self.register = bool(register)
+        self.shift = (0.0, 0.0)  # the last frame's measured (dx, dy), luma pixels (register or stabilize)
         self.shifts = ShiftLog()
         self._zeros = np.zeros((int(bins), 3))
         x, y, w, h = roi
@@ -415,13 +428,14 @@ class RgbProjector:
             self._yuv = np.zeros((2, len(self.cols) - 1, 3))
             rects = _fused_rects(planes, self.rows, self.cols)
             self._fused = None if rects is None else _FusedProjection(
-                rects, self.vertical, self.stabilize, (planes.sub_x, planes.sub_y))
+                rects, self.vertical, self.stabilize, (planes.sub_x, planes.sub_y), self.register)
         v = self.vertical
         if self._fused is not None:
             arrays = (planes.y,) if planes.u is None else (planes.y, planes.u, planes.v)
             m = self._fused(arrays)
-            if self.stabilize:
-                self.shifts.add(*self._fused.shift)
+            if self.stabilize or self.register:
+                self.shift = self._fused.shift
+                self.shifts.add(*self.shift)
             if planes.u is None:
                 m = np.repeat(m, 3, axis=2)  # y alone: rgb_affine's chroma rows are then zero
             rgb = (m @ self._m + self._b).astype(np.float32).astype(np.float64)

@@ -64,13 +64,18 @@ AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged o
 class Options:
     deflicker: bool = True
     exposure: bool = True
+    shake: bool = True  # regression on the measured shifts (shake.py), where a stream measured them
 
     @property
     def any(self) -> bool:
+        return self.deflicker or self.exposure or self.shake
+
+    @property
+    def light(self) -> bool:
         return self.deflicker or self.exposure
 
 
-OFF = Options(False, False)
+OFF = Options(False, False, False)
 
 
 def fold(f: float, rate: float) -> float:
@@ -413,7 +418,7 @@ def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options
     None when nothing was found."""
     levels = np.asarray(levels, np.float64)
     t = levels.shape[0]
-    if t < MIN_SAMPLES or not options.any:
+    if t < MIN_SAMPLES or not options.light:
         return None
     mean = levels.mean(axis=0)
     ok = mean > 1e-6 * max(float(np.abs(mean).max()), 1e-12)
@@ -465,13 +470,16 @@ def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options
 
 # ------------------------------------------------------------------------------------ windows
 def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: float, *, lines=(),
-                    options: Options = Options(), starts=None, vertical_index: int | None = None):
+                    options: Options = Options(), starts=None, vertical_index: int | None = None,
+                    shifts: np.ndarray | None = None):
     """Correct plot windows in place of the classifiers' path.
 
     ``parts``: [(n, bins, T, 3) windows relative to ``offsets`` [(n or 1, bins, 3)]] (e.g.
     horizontal and vertical); all parts of a window are fitted together (a part that is all zero,
-    such as a vertical plot not computed, is left out). Returns (corrected parts (float32),
-    [findings per window]).
+    such as a vertical plot not computed, is left out). ``shifts``: (n, T, 2) each sample's
+    measured camera shift, when the stream registered its frames: the shake is regressed out
+    first (:mod:`wallcli.signal.shake`), then the light's nuisances are fitted on what is left.
+    Returns (corrected parts (float32), [findings per window]).
     """
     n = parts[0].shape[0]
     out = [np.array(p, np.float32, copy=True) for p in parts]
@@ -490,6 +498,11 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
             used.append(k)
         if not raws:
             continue
+        shaken = None
+        if options.shake and shifts is not None:
+            shaken = _unshake(raws, shifts[w])
+            if shaken is not None:
+                found[w].append(shaken)
         # colours summed: the nuisances are grey; (T, K) with K the bins of every part used
         series = np.concatenate([r.sum(axis=-1).T for r in raws], axis=1)
         vs = None
@@ -499,17 +512,36 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
         t0 = 0.0 if starts is None else float(starts[w])
         part = np.concatenate([np.full(r.shape[0], i) for i, r in enumerate(raws)])
         res = fit(series, rate, lines=lines, options=options, t0=t0, vertical=vs, part=part)
-        if res is None:
+        if res is None and shaken is None:
             continue
         pos = 0
         for k, raw in zip(used, raws):
             b = raw.shape[0]
-            g = res.gain[:, pos:pos + b].T[:, :, None]  # (bins, T, 1)
+            g = 0.0 if res is None else res.gain[:, pos:pos + b].T[:, :, None]  # (bins, T, 1)
             pos += b
             o = np.asarray(offsets[k], np.float64)[min(w, np.asarray(offsets[k]).shape[0] - 1)][:, None, :]
             out[k][w] = (raw / (1.0 + g) - o).astype(np.float32)
-        found[w] = res.findings
+        if res is not None:
+            found[w] += res.findings
     return out, found
+
+
+def _unshake(raws: list[np.ndarray], shifts: np.ndarray) -> dict[str, Any] | None:
+    """Regress the shake out of one window's parts [(bins, T, 3)], in place, all together (one
+    camera moved them all); the finding, or None when the shifts explain nothing."""
+    from wallcli.signal.shake import unshake
+
+    t = raws[0].shape[1]
+    series = np.concatenate([r.transpose(1, 0, 2).reshape(t, -1) for r in raws], axis=1)
+    fixed, finding = unshake(series, shifts)
+    if finding is None:
+        return None
+    pos = 0
+    for r in raws:
+        n = r.shape[0] * r.shape[2]
+        r[...] = fixed[:, pos:pos + n].reshape(t, r.shape[0], r.shape[2]).transpose(1, 0, 2)
+        pos += n
+    return finding
 
 
 def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
@@ -544,6 +576,12 @@ def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
     drift = [f["amplitude"] for fs in per_window for f in fs if f["kind"] == "drift"]
     if drift:
         out.append({"kind": "drift", "amplitude": round(float(max(drift)), 5), "windows": len(drift)})
+    shake = [f for fs in per_window for f in fs if f["kind"] == "shake"]
+    if shake:
+        out.append({"kind": "shake", "rms_px": round(float(np.median([f["rms_px"] for f in shake])), 3),
+                    "max_px": round(float(max(f["max_px"] for f in shake)), 3),
+                    "explained": round(float(np.median([f["explained"] for f in shake])), 4),
+                    "windows": len(shake)})
     return out
 
 

@@ -222,7 +222,7 @@ class SnrAccumulator:
         self.scales = tuple(scales)
         self.frames = 0
         self.warnings: list[str] = []
-        self.options = corrections if corrections is not None and corrections.any and fps else None
+        self.options = corrections if corrections is not None and corrections.light and fps else None
         self.fps = fps
         self.gains = None
         self._waiting = None

@@ -45,9 +45,15 @@ class StPlot:
 class RowReducer:
     """Per frame: the raw (not mean-removed) horizontal and vertical rows, float64 (bins, 3)."""
 
-    def __init__(self, roi: Roi, bins: int = 64, vertical: bool = True, stabilize: bool = False):
+    def __init__(self, roi: Roi, bins: int = 64, vertical: bool = True, stabilize: bool = False,
+                 register: bool = False):
         self.roi, self.bins = roi, int(bins)
-        self._project = RgbProjector(roi, self.bins, vertical, stabilize)
+        self._project = RgbProjector(roi, self.bins, vertical, stabilize, register)
+
+    @property
+    def shift(self) -> tuple[float, float]:
+        """The last frame's measured (dx, dy) in luma pixels ((0, 0) unless registering)."""
+        return self._project.shift
 
     @property
     def shifts(self):
