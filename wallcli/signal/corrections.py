@@ -58,6 +58,7 @@ AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change al
 AGREE_EACH = 0.5  # and in each profile
 PAIRS = True  # two quick ramps a few tenths apart, with a level between, judged as one step
 AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged on
+OPEN_ENDS = True  # a step too close to the window's end to be measured is taken as a ramp there
 
 
 @dataclass(frozen=True)
@@ -276,6 +277,49 @@ def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[i
     return None
 
 
+def _open_ends(g, rel, w, basis, found, thr, noise, sigma, m, part) -> list[tuple[int, int, int, float]]:
+    """[(first, end, index, size)] of the stretches at the window's ends where a step of the light
+    began (or ended) too close to the end for a plateau to measure it on (within ``m`` samples):
+    there the level leaves what the fit of the rest (the cubic and the steps) predicts by at least
+    a step's threshold, quickly (back to within a tenth of that inside the ``m`` samples) and alike
+    in the bins (:func:`_agree`). Left in, such a few samples of offset bend the cubic and reach
+    the classifiers as a change of the whole wall at the window's edge; taken as a ramp (the
+    model there is what was measured), they go. ``index``/``size``: where it begins and its size
+    as seen at the end."""
+    t = g.size
+    if t < 4 * m:
+        return []
+    n = np.arange(t)
+    ww = w.copy()
+    ww[:m] = 0.0
+    ww[-m:] = 0.0
+    keep = ww > 0
+    design = np.concatenate([basis] + [(n >= j).astype(np.float64)[:, None] for j in found], axis=1)
+    pinv = np.linalg.pinv(design[keep])
+    r = g - design @ (pinv @ g[keep])
+    out = []
+    for zone in (np.arange(t - 1, t - m - 1, -1), np.arange(m)):  # from the end inwards
+        zone = zone[w[zone] > 0]
+        if zone.size < 2 or abs(r[zone[0]]) < thr:
+            continue
+        d0 = r[zone[0]]
+        away = (np.sign(r[zone]) == np.sign(d0)) & (np.abs(r[zone]) >= max(0.1 * abs(d0), 3 * noise))
+        run = int(np.argmin(away)) if not away.all() else zone.size
+        if run >= zone.size:
+            continue  # not back within the zone: a slow change, or the fit bent, not a step's edge
+        idx = zone[:run]
+        rb = rel - design @ (pinv @ rel[keep])
+        per_bin = rb[idx].mean(axis=0)
+        common = float(r[idx].mean())
+        tol = 4 * sigma * np.sqrt(1.0 / idx.size + 1.0 / keep.sum())
+        if not _agree(per_bin[:, None], np.array([common]), tol, part):
+            continue
+        lo, hi = int(idx.min()), int(idx.max()) + 1
+        j = lo if zone[0] > zone[-1] else hi
+        out.append((lo, hi, j, float(d0 if zone[0] > zone[-1] else -d0)))
+    return out
+
+
 def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
     """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
     changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins.
@@ -367,6 +411,9 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         for i, j in enumerate(found):
             if any(abs(j - k) < halves[i] + span for k in found if k != j):
                 sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
+    ends = _open_ends(g, rel, w, basis, found, thr, noise, sigma, half + least + 1, part) if OPEN_ENDS else []
+    for lo, hi, _, _ in ends:
+        w[lo:hi] = 0.0
     steps_g = stepped()
     keep = w > 0
     nb = basis.shape[1]
@@ -382,8 +429,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
     model = model + steps_g
     order = sorted(zip(found, halves))
-    for j, hj in order:  # within a ramp the step's shape is what was measured, not a jump
-        lo, hi = max(j - hj - 1, 0), min(j + hj + 1, t)
+    ramps = [(max(j - hj - 1, 0), min(j + hj + 1, t)) for j, hj in order] + [(lo, hi) for lo, hi, _, _ in ends]
+    for lo, hi in ramps:  # within a ramp the step's shape is what was measured, not a jump
         around = np.arange(max(lo - span, 0), min(hi + span, t))
         around = around[keep[around]]
         model[lo:hi] = g[lo:hi] - (np.median((g - model)[around]) if around.size else 0.0)
@@ -391,7 +438,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     # level between them is only seen there, not in the fitted jumps)
     steps = [(j, float(np.mean(model[min(j + hj + 1, t - 1):min(j + hj + 3, t)])
                         - np.mean(model[max(j - hj - 3, 0):max(j - hj - 1, 1)]))) for j, hj in order]
-    return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
+    steps += [(j, size, True) for _, _, j, size in ends]
+    return model, sorted(steps), ptp if ptp >= DRIFT_MIN else 0.0
 
 
 # ------------------------------------------------------------------------------------ the fit
@@ -455,7 +503,8 @@ def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options
             gain = (1.0 + gain) * np.exp(model)[:, None] - 1.0
             if steps:
                 findings.append({"kind": "exposure", "steps": [
-                    {"time": round(t0 + j / rate, 3), "size": round(float(np.expm1(s)), 5)} for j, s in steps]})
+                    {"time": round(t0 + st[0] / rate, 3), "size": round(float(np.expm1(st[1])), 5)}
+                    | ({"partial": True} if len(st) > 2 else {}) for st in steps]})
             if drift:
                 findings.append({"kind": "drift", "amplitude": round(float(np.expm1(drift / 2)), 5)})
     if not findings:
@@ -538,6 +587,8 @@ def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
                 kept[-1].append(s)
             else:
                 kept.append([s])
+        # a step seen whole in one window and cut by another's end is sized from the whole one
+        kept = [[s for s in g if not s.get("partial")] or g for g in kept]
         out.append({"kind": "exposure", "steps": [
             {"time": round(float(np.median([s["time"] for s in g])), 3),
              "size": round(float(np.median([s["size"] for s in g])), 5)} for g in kept]})
