@@ -58,6 +58,7 @@ AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change al
 AGREE_EACH = 0.5  # and in each profile
 PAIRS = True  # two quick ramps a few tenths apart, with a level between, judged as one step
 AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged on
+CENTRE = True  # a step is placed at its ramp's middle, the ramp as long as measured
 OPEN_ENDS = True  # a step too close to the window's end to be measured is taken as a ramp there
 
 
@@ -238,18 +239,23 @@ def _rise(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> int:
     means of the (up to) ``span`` samples before and after it that ``w`` counts (a light's step is
     quick; the whole wall dims or brightens as a person moves in front of a lamp over half a
     second or more). Samples ``w`` leaves out (other steps' ramps) are read as the nearest level."""
-    t = g.size
+    where = _ramp(g, w, j, half, span)
+    return g.size if where is None else where[1] - where[0]
+
+
+def _ramp(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> tuple[int, int] | None:
+    """(sample at 10 %, sample at 90 %) of the change of ``g`` around ``j`` (:func:`_rise`), or None."""
     change = _fraction_of_change(g, w, j, half, span)
     if change is None:
-        return t
+        return None
     seg = change[0][1:-1]
     above = np.flatnonzero(seg >= 0.9)
     if above.size == 0:
-        return t
+        return None
     end = int(above[0])
     below = np.flatnonzero(seg[:end] <= 0.1)
     start = int(below[-1]) if below.size else 0
-    return end - start
+    return change[1] + 1 + start, change[1] + 1 + end
 
 
 def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[int, int] | None:
@@ -389,6 +395,21 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         if ok:
             others = stepped()
             hj = half
+            where = _ramp(g - others, w, j, half, span) if CENTRE else None
+            if where is not None and where[1] - where[0] <= ramp:
+                # the largest difference of adjacent means can sit at a slow ramp's end, so that
+                # the ramp left out of the fits (a ramp's length, centred on the step) misses half
+                # of it and the spans take it in: the step is where the level moves, if the change
+                # measured across the ramp there is the larger (a step beside another one, not yet
+                # found, moves the levels the middle is measured between) and its ramp does not
+                # run into a found step's (a shared ramp is no one step's)
+                mid = int(round(0.5 * (where[0] + where[1])))
+                if (mid != j and abs(mid - j) <= half and idx[0] <= mid <= idx[-1]
+                        and all(abs(mid - k) >= half + hk for k, hk in zip(found, halves))):
+                    size_at = [abs(np.median(_local_steps(rel - others[:, None], w, i, half, span))) for i in (j, mid)]
+                    if size_at[1] > size_at[0]:
+                        j = mid
+                        nb, na = counts(j)
             if _rise(g - others, w, j, half, span) > ramp + 3:
                 two = _pair(g - others, w, j, ramp, span) if PAIRS else None
                 hj = max(j - two[0], two[1] - j) if two is not None else -1
@@ -409,7 +430,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         # a step whose spans reached across another one, found after it, was sized with that one in
         # them: size it again with the others' sizes taken out
         for i, j in enumerate(found):
-            if any(abs(j - k) < halves[i] + span for k in found if k != j):
+            if any(abs(j - k) < halves[i] + hk + span for k, hk in zip(found, halves) if k != j):
                 sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
     ends = _open_ends(g, rel, w, basis, found, thr, noise, sigma, half + least + 1, part) if OPEN_ENDS else []
     for lo, hi, _, _ in ends:
