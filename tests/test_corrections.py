@@ -325,6 +325,7 @@ def test_a_step_cut_by_the_stretchs_end_is_taken_as_a_ramp(at):
     whole = {"time": round(at + 0.07, 3), "size": 0.02}
     merged = C.merge([fit.findings, [{"kind": "exposure", "steps": [whole]}]])
     assert merged[0]["steps"] == [whole]  # the whole step's size, not the cut one's
+    assert C.merge([fit.findings])[0]["steps"][0]["partial"]  # seen only cut: said so
 
 
 def test_a_slow_ramps_step_is_placed_at_its_middle():

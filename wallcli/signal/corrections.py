@@ -28,7 +28,8 @@ shape a person does not make:
 
 ``correct`` divides the found gains out and returns what was found; ``merge`` sums a clip's
 findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
-``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``).
+``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``; a
+step that a window's end cut wherever it was seen, taken as a ramp there, carries ``"partial": True``).
 A slot for camera shake (``kind: "shake"``) belongs beside these, before the block sums.
 """
 from __future__ import annotations
@@ -612,7 +613,8 @@ def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
         kept = [[s for s in g if not s.get("partial")] or g for g in kept]
         out.append({"kind": "exposure", "steps": [
             {"time": round(float(np.median([s["time"] for s in g])), 3),
-             "size": round(float(np.median([s["size"] for s in g])), 5)} for g in kept]})
+             "size": round(float(np.median([s["size"] for s in g])), 5)}
+            | ({"partial": True} if all(s.get("partial") for s in g) else {}) for g in kept]})
     drift = [f["amplitude"] for fs in per_window for f in fs if f["kind"] == "drift"]
     if drift:
         out.append({"kind": "drift", "amplitude": round(float(max(drift)), 5), "windows": len(drift)})
