@@ -28,7 +28,8 @@ shape a person does not make:
 
 ``correct`` divides the found gains out and returns what was found; ``merge`` sums a clip's
 findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
-``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``).
+``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``; a
+step that a window's end cut wherever it was seen, taken as a ramp there, carries ``"partial": True``).
 A slot for camera shake (``kind: "shake"``) belongs beside these, before the block sums.
 """
 from __future__ import annotations
@@ -58,6 +59,8 @@ AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change al
 AGREE_EACH = 0.5  # and in each profile
 PAIRS = True  # two quick ramps a few tenths apart, with a level between, judged as one step
 AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged on
+CENTRE = True  # a step is placed at its ramp's middle, the ramp as long as measured
+OPEN_ENDS = True  # a step too close to the window's end to be measured is taken as a ramp there
 
 
 @dataclass(frozen=True)
@@ -242,18 +245,23 @@ def _rise(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> int:
     means of the (up to) ``span`` samples before and after it that ``w`` counts (a light's step is
     quick; the whole wall dims or brightens as a person moves in front of a lamp over half a
     second or more). Samples ``w`` leaves out (other steps' ramps) are read as the nearest level."""
-    t = g.size
+    where = _ramp(g, w, j, half, span)
+    return g.size if where is None else where[1] - where[0]
+
+
+def _ramp(g: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> tuple[int, int] | None:
+    """(sample at 10 %, sample at 90 %) of the change of ``g`` around ``j`` (:func:`_rise`), or None."""
     change = _fraction_of_change(g, w, j, half, span)
     if change is None:
-        return t
+        return None
     seg = change[0][1:-1]
     above = np.flatnonzero(seg >= 0.9)
     if above.size == 0:
-        return t
+        return None
     end = int(above[0])
     below = np.flatnonzero(seg[:end] <= 0.1)
     start = int(below[-1]) if below.size else 0
-    return end - start
+    return change[1] + 1 + start, change[1] + 1 + end
 
 
 def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[int, int] | None:
@@ -279,6 +287,49 @@ def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[i
             if a - start <= ramp + 3 and end - (a + 2) <= ramp + 3:
                 return lo + start, lo + end + 1
     return None
+
+
+def _open_ends(g, rel, w, basis, found, thr, noise, sigma, m, part) -> list[tuple[int, int, int, float]]:
+    """[(first, end, index, size)] of the stretches at the window's ends where a step of the light
+    began (or ended) too close to the end for a plateau to measure it on (within ``m`` samples):
+    there the level leaves what the fit of the rest (the cubic and the steps) predicts by at least
+    a step's threshold, quickly (back to within a tenth of that inside the ``m`` samples) and alike
+    in the bins (:func:`_agree`). Left in, such a few samples of offset bend the cubic and reach
+    the classifiers as a change of the whole wall at the window's edge; taken as a ramp (the
+    model there is what was measured), they go. ``index``/``size``: where it begins and its size
+    as seen at the end."""
+    t = g.size
+    if t < 4 * m:
+        return []
+    n = np.arange(t)
+    ww = w.copy()
+    ww[:m] = 0.0
+    ww[-m:] = 0.0
+    keep = ww > 0
+    design = np.concatenate([basis] + [(n >= j).astype(np.float64)[:, None] for j in found], axis=1)
+    pinv = np.linalg.pinv(design[keep])
+    r = g - design @ (pinv @ g[keep])
+    out = []
+    for zone in (np.arange(t - 1, t - m - 1, -1), np.arange(m)):  # from the end inwards
+        zone = zone[w[zone] > 0]
+        if zone.size < 2 or abs(r[zone[0]]) < thr:
+            continue
+        d0 = r[zone[0]]
+        away = (np.sign(r[zone]) == np.sign(d0)) & (np.abs(r[zone]) >= max(0.1 * abs(d0), 3 * noise))
+        run = int(np.argmin(away)) if not away.all() else zone.size
+        if run >= zone.size:
+            continue  # not back within the zone: a slow change, or the fit bent, not a step's edge
+        idx = zone[:run]
+        rb = rel - design @ (pinv @ rel[keep])
+        per_bin = rb[idx].mean(axis=0)
+        common = float(r[idx].mean())
+        tol = 4 * sigma * np.sqrt(1.0 / idx.size + 1.0 / keep.sum())
+        if not _agree(per_bin[:, None], np.array([common]), tol, part):
+            continue
+        lo, hi = int(idx.min()), int(idx.max()) + 1
+        j = lo if zone[0] > zone[-1] else hi
+        out.append((lo, hi, j, float(d0 if zone[0] > zone[-1] else -d0)))
+    return out
 
 
 def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
@@ -350,6 +401,21 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         if ok:
             others = stepped()
             hj = half
+            where = _ramp(g - others, w, j, half, span) if CENTRE else None
+            if where is not None and where[1] - where[0] <= ramp:
+                # the largest difference of adjacent means can sit at a slow ramp's end, so that
+                # the ramp left out of the fits (a ramp's length, centred on the step) misses half
+                # of it and the spans take it in: the step is where the level moves, if the change
+                # measured across the ramp there is the larger (a step beside another one, not yet
+                # found, moves the levels the middle is measured between) and its ramp does not
+                # run into a found step's (a shared ramp is no one step's)
+                mid = int(round(0.5 * (where[0] + where[1])))
+                if (mid != j and abs(mid - j) <= half and idx[0] <= mid <= idx[-1]
+                        and all(abs(mid - k) >= half + hk for k, hk in zip(found, halves))):
+                    size_at = [abs(np.median(_local_steps(rel - others[:, None], w, i, half, span))) for i in (j, mid)]
+                    if size_at[1] > size_at[0]:
+                        j = mid
+                        nb, na = counts(j)
             if _rise(g - others, w, j, half, span) > ramp + 3:
                 two = _pair(g - others, w, j, ramp, span) if PAIRS else None
                 hj = max(j - two[0], two[1] - j) if two is not None else -1
@@ -370,8 +436,11 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         # a step whose spans reached across another one, found after it, was sized with that one in
         # them: size it again with the others' sizes taken out
         for i, j in enumerate(found):
-            if any(abs(j - k) < halves[i] + span for k in found if k != j):
+            if any(abs(j - k) < halves[i] + hk + span for k, hk in zip(found, halves) if k != j):
                 sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
+    ends = _open_ends(g, rel, w, basis, found, thr, noise, sigma, half + least + 1, part) if OPEN_ENDS else []
+    for lo, hi, _, _ in ends:
+        w[lo:hi] = 0.0
     steps_g = stepped()
     keep = w > 0
     nb = basis.shape[1]
@@ -387,8 +456,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     model = drift.copy() if ptp >= DRIFT_MIN else np.zeros(t)
     model = model + steps_g
     order = sorted(zip(found, halves))
-    for j, hj in order:  # within a ramp the step's shape is what was measured, not a jump
-        lo, hi = max(j - hj - 1, 0), min(j + hj + 1, t)
+    ramps = [(max(j - hj - 1, 0), min(j + hj + 1, t)) for j, hj in order] + [(lo, hi) for lo, hi, _, _ in ends]
+    for lo, hi in ramps:  # within a ramp the step's shape is what was measured, not a jump
         around = np.arange(max(lo - span, 0), min(hi + span, t))
         around = around[keep[around]]
         model[lo:hi] = g[lo:hi] - (np.median((g - model)[around]) if around.size else 0.0)
@@ -396,7 +465,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     # level between them is only seen there, not in the fitted jumps)
     steps = [(j, float(np.mean(model[min(j + hj + 1, t - 1):min(j + hj + 3, t)])
                         - np.mean(model[max(j - hj - 3, 0):max(j - hj - 1, 1)]))) for j, hj in order]
-    return model, steps, ptp if ptp >= DRIFT_MIN else 0.0
+    steps += [(j, size, True) for _, _, j, size in ends]
+    return model, sorted(steps), ptp if ptp >= DRIFT_MIN else 0.0
 
 
 # ------------------------------------------------------------------------------------ the fit
@@ -460,7 +530,8 @@ def fit(levels: np.ndarray, rate: float, *, lines=(), options: Options = Options
             gain = (1.0 + gain) * np.exp(model)[:, None] - 1.0
             if steps:
                 findings.append({"kind": "exposure", "steps": [
-                    {"time": round(t0 + j / rate, 3), "size": round(float(np.expm1(s)), 5)} for j, s in steps]})
+                    {"time": round(t0 + st[0] / rate, 3), "size": round(float(np.expm1(st[1])), 5)}
+                    | ({"partial": True} if len(st) > 2 else {}) for st in steps]})
             if drift:
                 findings.append({"kind": "drift", "amplitude": round(float(np.expm1(drift / 2)), 5)})
     if not findings:
@@ -570,9 +641,12 @@ def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
                 kept[-1].append(s)
             else:
                 kept.append([s])
+        # a step seen whole in one window and cut by another's end is sized from the whole one
+        kept = [[s for s in g if not s.get("partial")] or g for g in kept]
         out.append({"kind": "exposure", "steps": [
             {"time": round(float(np.median([s["time"] for s in g])), 3),
-             "size": round(float(np.median([s["size"] for s in g])), 5)} for g in kept]})
+             "size": round(float(np.median([s["size"] for s in g])), 5)}
+            | ({"partial": True} if all(s.get("partial") for s in g) else {}) for g in kept]})
     drift = [f["amplitude"] for fs in per_window for f in fs if f["kind"] == "drift"]
     if drift:
         out.append({"kind": "drift", "amplitude": round(float(max(drift)), 5), "windows": len(drift)})
