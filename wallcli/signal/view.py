@@ -464,19 +464,13 @@ class ViewCheck:
             # counted as a quarter of the pixels (interpolation and compression correlate them).
             # e is the residual itself, not the frame-to-frame noise: a codec that repeats static
             # blocks makes consecutive frames alike but not the reference's texture
-            # only pixels that both warps fill from inside the frame: a reflected border repeats
-            # what lies along one edge (a skirting board, a shadow) into the one warp and not into
-            # its mirror, which made the two differ by tens of spreads on still walls whose
-            # correlation peak landed 7-30 px off (session 18, research/view/README.md)
-            cy, cx = slice(8 + int(abs(dy)), -8 - int(abs(dy))), slice(8 + int(abs(dx)), -8 - int(abs(dx)))
-            if hp[cy, cx].size < hp.size // 4:  # a shift of half the frame: nothing left to compare
-                cy, cx = slice(8, -8), slice(8, -8)
+            c = slice(8, -8)
             e = []
             for sg in (1, -1):
                 m = np.float32([[1, 0, sg * dx], [0, 1, sg * dy]])
                 warped = cv2.warpAffine(self._ref_h, m, hp.shape[::-1], borderMode=cv2.BORDER_REFLECT)
-                e.append(float(np.mean((hp - warped)[cy, cx] ** 2)))
-            n = hp[cy, cx].size / 4
+                e.append(float(np.mean((hp - warped)[c, c] ** 2)))
+            n = hp[c, c].size / 4
             fits = (e[1] - e[0]) > K_SHIFT * max(e[0], var_h) * np.sqrt(8.0 / n)
             # and it must hold from one frame to the next: a camera moves smoothly, while the
             # correlation peaks of noise land anywhere
