@@ -200,3 +200,19 @@ def test_hard_shadows_of_people_near_the_wall_are_not_moving_objects(tmp_path):
                       crf=18, nuisance_p=0.5, distance=(1.0, 2.0))
     view = _check(_encode(tmp_path / "s.mp4", sample_scene(3, cfg).frames()))
     assert view["usable"], view
+
+
+def test_a_cut_between_alike_views_is_a_scene_cut(tmp_path):
+    """A cut to a view of the same wall under another light: darker (a gain, which the check
+    divides out as it would an exposure change) and lit up to 1.7 % more on one side and less on
+    the other, a soft slope across the frame (under REL_CUT in every block, so no share of blocks
+    changes): its coarse pattern changes at one frame and never again. The code before session 18
+    passed it as a usable view."""
+    from wallcli.sim import views
+
+    a = list(_scene(31, "base"))
+    x = np.linspace(-1.0, 1.0, a[0].shape[1], dtype=np.float32)[None, :, None]
+    shade = np.float32(0.8) * (1 + np.float32(0.017) * np.tanh(x / np.float32(0.4)))
+    b = [np.clip(np.rint(f * shade), 0, 255).astype(np.uint8) for f in a]
+    view = _check(_encode(tmp_path / "c.mp4", views.cut(a, b, np.random.default_rng(3), n=N)))
+    assert view["issues"] == ["scene cut"], view

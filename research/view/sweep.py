@@ -74,6 +74,8 @@ def make(a) -> None:
                 jobs.append(("pan", p, lambda rng, p=p: views.pan(frames, rng, n=N, fps=FPS, amplitude=p)))
                 jobs.append(("shake", s, lambda rng, s=s: views.shake(frames, rng, n=N, fps=FPS, rms=s)))
             for m, (kind, param, fn) in enumerate(jobs):
+                if a.kinds and kind not in a.kinds.split(","):
+                    continue  # its index m (and so its rng) stays what a full run gives it
                 name = f"{kind}_{param}_{world}_{dom}_{seed}_{m}.mp4".replace("None_", "")
                 rng = np.random.default_rng([seed, m])
                 views.encode(fn(rng), out / name, fps=FPS)
@@ -154,6 +156,7 @@ def main() -> None:
     m.add_argument("--start", type=int, default=0)
     m.add_argument("--seed", type=int, default=17000)
     m.add_argument("--out", type=Path, default=Path("/tmp/view17"))
+    m.add_argument("--kinds", help="make only these kinds of clip, comma-separated (the wall is always rendered)")
     c = sub.add_parser("check")
     c.add_argument("--out", type=Path, default=Path("/tmp/view17"))
     c.add_argument("--transfer", type=Path)

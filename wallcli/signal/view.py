@@ -49,6 +49,18 @@ CUT_RATE = 15.0  # frames a second the cut watch compares (every other frame at 
 # one jump between any two of them, while a sweeping shadow changes a sample pair 2 frames apart
 # by a third of what 6 frames (a full check's spacing) did on the walls measured
 CUT_CALM = 0.1  # the frames before and after a cut (a codec settling after one, a shadow: up to 9 %)
+# A cut between two views of alike walls can change under a fifth of the blocks by 2 %: most of the
+# change is then the frame's gain, which is divided out, and a little of its spatial pattern. What is
+# left is coarse (the other room's shading) and comes in one step, while the codec's re-coding is
+# fine-grained and a person's light changes over many frames. So the gain-free step is also read on
+# CUT_CELLS cells along the long side, as an RMS relative to the level: a cut is a step CUT_SPIKE
+# times the clip's median step and each of the CUT_REACH steps on either side, and over REL_CUT / 2
+# (no hidden person changes that much of the wall's pattern between two samples). Session 18
+# (research/view/README.md): steps over the floor reached at most 2.7 times on 220 walls; the 15
+# cuts the changed share missed, 2.0-48 times (13 over 4)
+CUT_CELLS = 8
+CUT_SPIKE = 4.0
+CUT_REACH = 2
 MIN_MOVER_BLOCKS = 2
 MIN_SHIFT = 1.5  # source pixels from the reference frame
 K_SHIFT = 3.0  # z-score of the shift's fit against its mirror image (see _changes), held over
@@ -241,6 +253,8 @@ class ViewCheck:
         self._fracs = (1.0, 1.0)  # changed shares of the last two frames (none calm before the first)
         self._cut_prev = self._cut_t = None
         self._cut_sig: deque = deque(maxlen=HISTORY)
+        # the coarse gain-free steps (time of the later sample, RMS): the clip's, and the last few
+        self._cut_steps: deque = deque(maxlen=HISTORY + CUT_REACH + 1)
         self._cut_reset = False
         self._shifts: deque = deque(maxlen=HOLD_WITHIN)  # recent significant shifts (inf: none)
         # where the view failed, per block (clipped, too dark, or a mover in it), OR-ed over the
@@ -303,9 +317,41 @@ class ViewCheck:
         self._fracs = (before[1], frac)
         if frac >= CUT_CALM:
             self._dense_until = t + DENSE
+        spike = self._coarse_spike(t, blocks, prev, ok, gain)
         if before[1] > CUT_FRACTION and before[0] < CUT_CALM and frac < CUT_CALM:
             return t_prev
-        return None
+        return spike
+
+    def _coarse_spike(self, t, blocks, prev, ok, gain) -> float | None:
+        """The time of the step CUT_REACH samples back if it was a cut by its coarse pattern (see
+        CUT_CELLS): a step far above the clip's usual and its neighbours', and above REL_CUT / 2."""
+        import cv2
+
+        k = max(1, max(blocks.shape) // CUT_CELLS)
+        hh, ww = blocks.shape[0] // k * k, blocks.shape[1] // k * k
+        step = np.nan
+        if hh and ww and ok.mean() >= MIN_USABLE:
+            r = np.where(ok, (blocks - gain * prev) / np.maximum(prev, DARK), 0.0).astype(np.float32)
+            size = (ww // k, hh // k)
+            cells = cv2.resize(r[:hh, :ww], size, interpolation=cv2.INTER_AREA)
+            share = cv2.resize(ok[:hh, :ww].astype(np.float32), size, interpolation=cv2.INTER_AREA)
+            m = share > 0.5  # cells mostly usable: their mean is the usable blocks' mean
+            if m.any():
+                step = float(np.sqrt(np.mean((cells[m] / share[m]) ** 2)))
+        steps = self._cut_steps
+        steps.append((t, step))
+        n = 2 * CUT_REACH + 1
+        if len(steps) < n + 3:  # a median of at least 3 earlier steps
+            return None
+        recent = [s for _, s in list(steps)[-n:]]
+        t_mid, mid = steps[-CUT_REACH - 1]
+        if not mid > REL_CUT / 2:  # nan (too little usable) too
+            return None
+        others = [s for i, s in enumerate(recent) if i != CUT_REACH and s == s]
+        earlier = [s for _, s in list(steps)[:-n + CUT_REACH] if s == s]
+        if len(earlier) < 3 or (others and mid <= CUT_SPIKE * max(others)):
+            return None
+        return t_mid if mid > CUT_SPIKE * statistics.median(earlier) else None
 
     def _update(self, t: float, planes) -> None:
         import cv2
