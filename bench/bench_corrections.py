@@ -109,8 +109,8 @@ def micro(clip: Path) -> None:
     print("|---|---|---|---|---|---|")
     for task, model in models.items():
         ms = {name: 1e3 * _best(lambda o=o: _predict_window(model, win, ref, native=30.0, options=o))
-              for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False)),
-                              ("exposure", corr.Options(False, True)), ("both", corr.Options()))}
+              for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False, False)),
+                              ("exposure", corr.Options(False, True, False)), ("both", corr.Options(True, True, False)))}
         print(f"| {task} | {ms['off']:.1f} ms | {ms['deflicker']:.1f} ms | {ms['exposure']:.1f} ms | {ms['both']:.1f} ms "
               f"| {ms['off'] / ms['both']:.2f} |")
     n = 160
@@ -141,10 +141,14 @@ def micro(clip: Path) -> None:
         off = 1e3 * _best(lambda: project(False, vertical), 5) / n
         on = 1e3 * _best(lambda: project(True, vertical), 5) / n
         print(f"| profiles per 1080p frame, {label} | {off:.2f} ms | registered: {on:.2f} ms | ratio {off / on:.2f} |")
-    ms = {name: 1e3 * _best(lambda o=o: snr(o), 5) / n for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False)),
-                                                                        ("exposure", corr.Options(False, True)), ("both", corr.Options()))}
+    ms = {name: 1e3 * _best(lambda o=o: snr(o), 5) / n
+          for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False, False)),
+                          ("exposure", corr.Options(False, True, False)), ("both", corr.Options(True, True, False)),
+                          ("shake", corr.Options(False, False, True)), ("all", corr.Options()))}
     print(f"| snr, per 1080p frame | {ms['off']:.2f} ms | {ms['deflicker']:.2f} ms | {ms['exposure']:.2f} ms | "
           f"{ms['both']:.2f} ms | {ms['off'] / ms['both']:.2f} |")
+    print(f"| snr, per 1080p frame, shake alone / all | {ms['off']:.2f} ms | {ms['shake']:.2f} ms | {ms['all']:.2f} ms | "
+          f"ratio all: {ms['off'] / ms['all']:.2f} |")
 
 
 if __name__ == "__main__":

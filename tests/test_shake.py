@@ -133,3 +133,56 @@ def test_count_lists_shake_and_no_shake_turns_it_off(tmp_path, run_cli):
     code, out, err = run_cli("count", path, "--json", "--no-shake")
     assert code == 0, err
     assert "shake" not in [c["kind"] for c in json.loads(out)["corrections"]]
+
+
+def _snr(frames, shake: bool):
+    from wallcli.io.video import Planes
+    from wallcli.signal.corrections import Options
+    from wallcli.signal.snr import SnrAccumulator
+
+    acc = SnrAccumulator((0, 0, frames[0].shape[1], frames[0].shape[0]),
+                         corrections=Options(deflicker=False, exposure=False, shake=shake), fps=30.0)
+    for f in frames:
+        acc.update(Planes(f, None, None, kind="gray", full_range=True))
+    res = acc.result()
+    return {s.block: float(s.snr_db[1]) for s in res.scales}, acc.corrections
+
+
+def test_the_snr_of_a_shaking_clip_is_the_still_clips():
+    still, _ = _frames(0, 0.0)
+    shaking, _ = _frames(0, 0.5)
+    ref, found = _snr(still, True)
+    assert found == []  # a still camera: nothing fitted
+    off, _ = _snr(shaking, False)
+    on, found = _snr(shaking, True)
+    assert [f["kind"] for f in found] == ["shake"]
+    assert abs(off[8] - ref[8]) > 1.0  # the door frame's edges swing: the SNR is far off
+    for block in (4, 8, 16, 32):  # within 10 % in power (0.41 dB) wherever blocks average the noise
+        assert abs(on[block] - ref[block]) < 0.41, (block, on[block], ref[block])
+
+
+def test_shake_sums_give_the_regressed_series_sums_exactly():
+    """The SNR path's sums after the fact equal those of the series with the fit removed."""
+    from wallcli.signal.shake import ShakeSums, regressors
+
+    rng = np.random.default_rng(7)
+    t, p = 120, 6
+    shifts = _track(7, 0.5)[:t]
+    x = np.array([regressors(*s) for s in shifts])
+    y = np.cumsum(rng.standard_normal((t, p)), axis=0) * 0.2 + x @ rng.standard_normal((5, p))
+    c = (y - y[0]).astype(np.float32)  # centred on the first frame, as the estimator keeps them
+    sums = ShakeSums((p,))
+    sums.first(*shifts[0])
+    for i in range(1, t):
+        sums.add(c[i], c[i] - c[i - 1], *shifts[i])
+    d = np.diff(c, axis=0).astype(np.float64)  # float32 differences, as the estimator takes them
+    c64 = c.astype(np.float64)
+    s1, s2, sd, ds = c64.sum(0), (c64 ** 2).sum(0), (d ** 2).sum(0), d.sum(0)
+    got = sums.corrected(s1, s2, sd, ds, sums.xc, sums.dxd)
+    dx = np.diff(x, axis=0)
+    beta = np.linalg.lstsq(dx - dx.mean(0), d - d.mean(0), rcond=None)[0]
+    c2 = c - x @ beta
+    d2 = d - dx @ beta
+    want = (c2.sum(0), (c2 ** 2).sum(0), (d2 ** 2).sum(0), d2.sum(0))
+    for g, w in zip(got, want):
+        np.testing.assert_allclose(g, w, rtol=1e-6, atol=1e-6)

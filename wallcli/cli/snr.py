@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (THREADS_HELP, Number, corrections_of, deflicker_option, exposure_option, force_help,
+from wallcli.cli.common import (THREADS_HELP, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 number_option, strict_option, threads_option)
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
@@ -79,6 +79,7 @@ def snr(
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
+    no_shake: bool = shake_option(),
 ) -> None:
     """Measure the wall signal and the noise in a video, per colour channel (Sharma et al., What
     You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §3.2).
@@ -114,7 +115,7 @@ def snr(
     with committed_together():
         _measure(input, roi=roi, json_out=json_out, heatmap=heatmap, heatmap_of=heatmap_of, plot=plot,
                  max_pixels=max_pixels, force=force, threads=threads, strict=strict,
-                 corrections=corrections_of(no_deflicker, no_exposure))
+                 corrections=corrections_of(no_deflicker, no_exposure, no_shake))
 
 
 # ------------------------------------------------------------------------------------- measure

@@ -68,3 +68,104 @@ def unshake(series: np.ndarray, shifts: np.ndarray) -> tuple[np.ndarray, dict[st
     return y - fit, {"kind": "shake", "rms_px": round(rms, 3),
                      "max_px": round(float(np.sqrt(np.max(np.sum(c * c, axis=1)))), 3),
                      "explained": round(float(np.sum(fit * fit)) / max(float(np.sum(yc * yc)), 1e-30), 4)}
+
+
+def regressors(dx: float, dy: float) -> np.ndarray:
+    """The five terms of one sample's shift, uncentred (design() centres a stretch of them)."""
+    return np.array([dx, dy, dx * dx, dy * dy, dx * dy], np.float64)
+
+
+class ShakeSums:
+    """The SNR estimator's per-pixel sums corrected for the same regression, after the fact.
+
+    The estimator keeps, per pixel, sums over time of its centred value c, c^2 and its frame
+    difference d^2 (snr.py), never the series. The shake's fit needs only more sums: per pixel
+    sum(X c) and sum(dX d) (five each, with X the shift's terms), and the frame's sum(X), sum(dX),
+    sum(X X^T), sum(dX dX^T). With b = G^-1 sum(dX d), fitted on the changes as above (G: the
+    centred sum(dX dX^T)), the series c - X b has sums that follow from these exactly:
+    sum(c') = sum(c) - b.sum(X), sum(c'^2) = sum(c^2) - 2 b.sum(X c) + b^T sum(X X^T) b, and
+    alike for d. All are linear in the pixels, so block sizes come from the same pyramid.
+
+    The SNR estimator feeds it blocks of 2x2 pixels (a quarter of the values), and each frame
+    adds ten scaled copies of them: a BLAS product over buffered chunks was no faster per value
+    and its threads spun on the other core.
+    """
+
+    def __init__(self, shape: tuple[int, ...]):
+        self.shape = tuple(shape)
+        n = int(np.prod(self.shape))
+        self.xc = np.zeros((TERMS, n))
+        self.dxd = np.zeros((TERMS, n))
+        self.sx = np.zeros(TERMS)
+        self.sdx = np.zeros(TERMS)
+        self.xx = np.zeros((TERMS, TERMS))
+        self.dxdx = np.zeros((TERMS, TERMS))
+        self._prev = None
+        self.frames = 0
+
+    def first(self, dx: float, dy: float) -> None:
+        """The first frame: its value is the origin (c = 0), its shift counts in the frame sums."""
+        x = regressors(dx, dy)
+        self.sx += x
+        self.xx += np.outer(x, x)
+        self._prev = x
+        self.frames = 1
+
+    def add(self, c: np.ndarray, d: np.ndarray, dx: float, dy: float) -> None:
+        x = regressors(dx, dy)
+        step = x - self._prev
+        self._prev = x
+        # float64 products: a float32 one rounds a faint signal's share of the sums
+        c, d = c.reshape(-1).astype(np.float64), d.reshape(-1).astype(np.float64)
+        for j in range(TERMS):
+            self.xc[j] += x[j] * c
+            self.dxd[j] += step[j] * d
+        self.sx += x
+        self.sdx += step
+        self.xx += np.outer(x, x)
+        self.dxdx += np.outer(step, step)
+        self.frames += 1
+
+    def flush(self) -> None:
+        """Nothing is buffered (kept for the estimator's call before its sums are read)."""
+
+    def _centred_g(self) -> np.ndarray:
+        n = max(self.frames - 1, 1)
+        return self.dxdx - np.outer(self.sdx, self.sdx) / n
+
+    def finding(self, sd: np.ndarray, dsum: np.ndarray, dxd: np.ndarray) -> dict[str, Any] | None:
+        """The shake found, judged as :func:`unshake` does, on blocks' changes (``sd``, ``dsum``:
+        their sums of squared differences and of differences; ``dxd``: their (5, ...) sums of
+        dX d), or None: then leave the sums."""
+        self.flush()
+        t = self.frames
+        if t <= 4 * TERMS:
+            return None
+        mean = self.sx[:2] / t
+        var = self.xx[0, 0] / t - mean[0] ** 2 + self.xx[1, 1] / t - mean[1] ** 2
+        rms = float(np.sqrt(max(var, 0.0)))
+        if rms < MIN_PX:
+            return None
+        g = self._centred_g()
+        a = dxd.reshape(TERMS, -1) - np.outer(self.sdx, dsum.reshape(-1)) / (t - 1)
+        beta = np.linalg.lstsq(g, a, rcond=1e-10)[0]
+        ss_fit = float(np.sum(beta * a))
+        ss_tot = float(np.sum(sd) - np.sum(dsum.astype(np.float64) ** 2) / (t - 1))
+        f = (ss_fit / TERMS) / max((ss_tot - ss_fit) / max(t - 1 - TERMS, 1), 1e-30)
+        if f < MIN_F:
+            return None
+        return {"kind": "shake", "rms_px": round(rms, 3), "explained": round(ss_fit / max(ss_tot, 1e-30), 4)}
+
+    def corrected(self, s1, s2, sd, dsum, xc, dxd):
+        """(s1, s2, sd, dsum) of one block size with the shake's fit removed; ``xc``, ``dxd``: that
+        size's (5, ...) block sums of sum(X c) and sum(dX d)."""
+        t = self.frames
+        shape = s1.shape
+        xc, dxd = xc.reshape(TERMS, -1), dxd.reshape(TERMS, -1)
+        ds = dsum.reshape(-1).astype(np.float64)
+        beta = np.linalg.lstsq(self._centred_g(), dxd - np.outer(self.sdx, ds) / (t - 1), rcond=1e-10)[0]
+        s1c = s1.reshape(-1) - self.sx @ beta
+        s2c = s2.reshape(-1) - 2 * np.sum(beta * xc, axis=0) + np.sum(beta * (self.xx @ beta), axis=0)
+        sdc = sd.reshape(-1) - 2 * np.sum(beta * dxd, axis=0) + np.sum(beta * (self.dxdx @ beta), axis=0)
+        dsc = ds - self.sdx @ beta
+        return s1c.reshape(shape), s2c.reshape(shape), sdc.reshape(shape), dsc.reshape(shape)

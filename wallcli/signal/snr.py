@@ -40,6 +40,7 @@ TILE = 32
 DEFAULT_MAX_PIXELS = 1 << 15
 CHUNK = 32  # frames summed in float32 before joining the float64 totals
 MIN_FRAMES = 3
+SHAKE_BLOCK = 2  # the block size from which the shake is regressed out (see SnrAccumulator)
 
 
 # ---------------------------------------------------------------------------------- helpers
@@ -213,6 +214,12 @@ class SnrAccumulator:
     sums (each pixel by the gain of its row band, so rolling-shutter bands go too). The gains are
     final a few seconds later (:class:`~wallcli.signal.corrections.LaggedGains`), so that many
     frames' measured pixels wait in memory; :attr:`corrections` says what was found.
+
+    With ``corrections.shake``, each frame's sub-pixel shift is measured on the ROI's luma line
+    sums and the camera's shake is regressed out of every pixel's series at the end, from sums
+    (:class:`wallcli.signal.shake.ShakeSums`), as the classifiers do on their plots; from blocks
+    of 2x2 pixels up (kept per pixel, its sums cost three times the estimator's own work; single
+    pixels' SNR is left uncorrected).
     """
 
     def __init__(self, roi: Roi, *, max_pixels: int = DEFAULT_MAX_PIXELS, scales=SCALES, corrections=None,
@@ -223,6 +230,9 @@ class SnrAccumulator:
         self.frames = 0
         self.warnings: list[str] = []
         self.options = corrections if corrections is not None and corrections.light and fps else None
+        self.shake = bool(corrections is not None and getattr(corrections, "shake", False))
+        self._shake = None  # ShakeSums, set up with the first frame
+        self._found_shake = None
         self.fps = fps
         self.gains = None
         self._waiting = None
@@ -239,6 +249,12 @@ class SnrAccumulator:
         self.chroma = planes.u is not None
         lat = self.lattice
         self.levels = [n for n in self.scales if lat.th // n >= 1 and lat.tw // n >= 1]
+        if self.shake and SHAKE_BLOCK in self.levels:
+            from wallcli.signal.blocks import LineShift
+            from wallcli.signal.shake import ShakeSums
+
+            self._lines = (LineShift(), LineShift())
+            self._shake = ShakeSums((3, lat.nty, lat.th // SHAKE_BLOCK, lat.ntx, lat.tw // SHAKE_BLOCK))
         if self.options is not None:
             from collections import deque
 
@@ -280,7 +296,25 @@ class SnrAccumulator:
     @property
     def corrections(self) -> list[dict]:
         """What the corrections found and removed (the JSON ``corrections``), [] without them."""
-        return self.gains.corrections() if self.gains is not None else []
+        found = self.gains.corrections() if self.gains is not None else []
+        return found + ([self._found_shake] if self._found_shake else [])
+
+    def _shift(self, planes) -> tuple[float, float]:
+        """The frame's (dx, dy) from the ROI's luma line sums (:class:`~wallcli.signal.blocks.LineShift`)."""
+        import cv2
+
+        x, y, w, h = self.roi
+        luma = planes.y[y:y + h, x:x + w]
+        # one OpenCV thread, as blocks.RgbProjector: its pool's hand-offs cost more than these sums
+        threads = cv2.getNumThreads()
+        cv2.setNumThreads(1)
+        try:
+            # every 4th row: a vertical feature's column profile is the same, at a quarter of the cost
+            cols = cv2.reduce(luma[::4], 0, cv2.REDUCE_SUM, dtype=cv2.CV_32F)[0]
+            rows = cv2.reduce(luma, 1, cv2.REDUCE_SUM, dtype=cv2.CV_32F)[:, 0]
+        finally:
+            cv2.setNumThreads(threads)
+        return self._lines[0](cols), self._lines[1](rows)
 
     def _profile(self, x: np.ndarray) -> np.ndarray:
         """Row-band then column-band sums of the measured pixels (colours summed)."""
@@ -293,24 +327,25 @@ class SnrAccumulator:
     def _release(self, ready) -> None:
         lat = self.lattice
         for _, g in ready:
-            x = self._waiting.popleft()
+            x, shift = self._waiting.popleft()
             if np.any(g):
                 per_row = (1.0 + g[:self._nr])[self.row_band].reshape(lat.nty, lat.th).astype(np.float32)
                 off = self._offset[:, None, None, None, None]
                 x += off
                 x /= per_row[None, :, :, None, None]
                 x -= off
-            self._add(x)
+            self._add(x, shift)
 
     def update(self, planes) -> None:
         if not self._ready:
             self._setup(planes)
             self._ready = True
         x = self._rgb(planes)
+        shift = self._shift(planes) if self._shake is not None else None
         if self.gains is None:
-            self._add(x)
+            self._add(x, shift)
             return
-        self._waiting.append(x)
+        self._waiting.append((x, shift))
         self._release(self.gains.push(self._profile(x)))
 
     def finish(self) -> None:
@@ -318,8 +353,10 @@ class SnrAccumulator:
         if self.gains is not None and self._waiting is not None:
             self._release(self.gains.flush())
 
-    def _add(self, x: np.ndarray) -> None:
+    def _add(self, x: np.ndarray, shift=None) -> None:
         if self.frames == 0:
+            if shift is not None:
+                self._shake.first(*shift)
             self.first = x
             self.prev = x
             # float32 sums over a chunk of frames (same-type adds cost about half of float32 ->
@@ -347,6 +384,8 @@ class SnrAccumulator:
         for n in self.levels:
             if n > 1:
                 c, d = _halve(c), _halve(d)
+            if n == SHAKE_BLOCK and shift is not None:
+                self._shake.add(c, d, *shift)
             b = self._buf[: c.size].reshape(c.shape)
             np.multiply(c, c, out=b)
             self.c2[n] += b
@@ -377,11 +416,30 @@ class SnrAccumulator:
         self._flush()
         s1 = self.s1
         dsum = (self.prev - self.first).astype(np.float64)
-        scales = []
+        sh = self._shake
+        per_level = {}  # block size -> (s1, dsum, sum(X c), sum(dX d)) block sums
+        xc = dxd = None
         for n in self.levels:
             if n > 1:
                 s1, dsum = _halve(s1), _halve(dsum)
-            sig, noi = powers_from_sums(s1, self.s2[n], self.sd[n], dsum, self.frames, float(n * n), (1, 2, 3, 4))
+                if xc is not None:
+                    xc, dxd = np.stack([_halve(a) for a in xc]), np.stack([_halve(a) for a in dxd])
+            if n == SHAKE_BLOCK and sh is not None:
+                sh.flush()
+                xc, dxd = sh.xc.reshape((-1,) + s1.shape), sh.dxd.reshape((-1,) + s1.shape)
+            per_level[n] = (s1, dsum, xc, dxd)
+        if sh is not None and self.levels:
+            # judged on the largest blocks, whose noise is averaged as a plot bin's is (the
+            # classifiers' bar); single pixels' noise would hide a shake's share
+            top = self.levels[-1]
+            self._found_shake = sh.finding(self.sd[top], per_level[top][1], per_level[top][3])
+        scales = []
+        for n in self.levels:
+            s1, dsum, xc, dxd = per_level[n]
+            sums = (s1, self.s2[n], self.sd[n], dsum)
+            if self._found_shake and xc is not None:
+                sums = sh.corrected(*sums, xc, dxd)
+            sig, noi = powers_from_sums(*sums, self.frames, float(n * n), (1, 2, 3, 4))
             scales.append(ScaleStats(n, sig, noi, int(np.prod(s1.shape[1:]))))
         return SnrResult(self.frames, self.roi, scales, self.lattice.pixels, self.lattice.exact, list(self.warnings))
 
