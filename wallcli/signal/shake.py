@@ -81,8 +81,8 @@ class ShakeSums:
     The estimator keeps, per pixel, sums over time of its centred value c, c^2 and its frame
     difference d^2 (snr.py), never the series. The shake's fit needs only more sums: per pixel
     sum(X c) and sum(dX d) (five each, with X the shift's terms), and the frame's sum(X), sum(dX),
-    sum(X X^T), sum(dX dX^T). With b = G^-1 sum(dX d), fitted on the changes as above (G: the
-    centred sum(dX dX^T)), the series c - X b has sums that follow from these exactly:
+    sum(X X^T), sum(dX dX^T). With b = sum(dX dX^T)^-1 sum(dX d), fitted on the changes as
+    :func:`unshake` fits them, the series c - X b has sums that follow from these exactly:
     sum(c') = sum(c) - b.sum(X), sum(c'^2) = sum(c^2) - 2 b.sum(X c) + b^T sum(X X^T) b, and
     alike for d. All are linear in the pixels, so block sizes come from the same pyramid.
 
@@ -129,10 +129,6 @@ class ShakeSums:
     def flush(self) -> None:
         """Nothing is buffered (kept for the estimator's call before its sums are read)."""
 
-    def _centred_g(self) -> np.ndarray:
-        n = max(self.frames - 1, 1)
-        return self.dxdx - np.outer(self.sdx, self.sdx) / n
-
     def finding(self, sd: np.ndarray, dsum: np.ndarray, dxd: np.ndarray) -> dict[str, Any] | None:
         """The shake found, judged as :func:`unshake` does, on blocks' changes (``sd``, ``dsum``:
         their sums of squared differences and of differences; ``dxd``: their (5, ...) sums of
@@ -146,11 +142,10 @@ class ShakeSums:
         rms = float(np.sqrt(max(var, 0.0)))
         if rms < MIN_PX:
             return None
-        g = self._centred_g()
-        a = dxd.reshape(TERMS, -1) - np.outer(self.sdx, dsum.reshape(-1)) / (t - 1)
-        beta = np.linalg.lstsq(g, a, rcond=1e-10)[0]
+        a = dxd.reshape(TERMS, -1)
+        beta = np.linalg.lstsq(self.dxdx, a, rcond=1e-10)[0]
         ss_fit = float(np.sum(beta * a))
-        ss_tot = float(np.sum(sd) - np.sum(dsum.astype(np.float64) ** 2) / (t - 1))
+        ss_tot = float(np.sum(sd))  # the changes' own, uncentred as the fit on them is
         f = (ss_fit / TERMS) / max((ss_tot - ss_fit) / max(t - 1 - TERMS, 1), 1e-30)
         if f < MIN_F:
             return None
@@ -159,11 +154,10 @@ class ShakeSums:
     def corrected(self, s1, s2, sd, dsum, xc, dxd):
         """(s1, s2, sd, dsum) of one block size with the shake's fit removed; ``xc``, ``dxd``: that
         size's (5, ...) block sums of sum(X c) and sum(dX d)."""
-        t = self.frames
         shape = s1.shape
         xc, dxd = xc.reshape(TERMS, -1), dxd.reshape(TERMS, -1)
         ds = dsum.reshape(-1).astype(np.float64)
-        beta = np.linalg.lstsq(self._centred_g(), dxd - np.outer(self.sdx, ds) / (t - 1), rcond=1e-10)[0]
+        beta = np.linalg.lstsq(self.dxdx, dxd, rcond=1e-10)[0]
         s1c = s1.reshape(-1) - self.sx @ beta
         s2c = s2.reshape(-1) - 2 * np.sum(beta * xc, axis=0) + np.sum(beta * (self.xx @ beta), axis=0)
         sdc = sd.reshape(-1) - 2 * np.sum(beta * dxd, axis=0) + np.sum(beta * (self.dxdx @ beta), axis=0)
