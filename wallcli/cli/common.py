@@ -139,7 +139,7 @@ EXPOSURE_HELP = ("Leave auto-exposure and gain steps and slow light drift in. By
                  "drift slower than about 8 s are found, divided out before analysis, and listed under "
                  "'corrections' in the JSON.")
 SHAKE_HELP = ("Leave camera shake in. By default each frame's sub-pixel shift is measured on the wall's "
-              "own features and, where the shifts explain the wall's changes, each bin's (or pixel's) "
+              "own features and, where the shifts explain the wall's changes, each bin's (or block's) "
               "response to them is fitted and removed (listed as 'shake' under 'corrections'). "
               "Motion the view check refuses is not made usable by it.")
 
