@@ -9,6 +9,8 @@ bins smaller than a pixel (as with 4:2:0 chroma of a small ROI).
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import numpy as np
 
 from wallcli.errors import WallcliError
@@ -190,6 +192,24 @@ def projection_means(plane: np.ndarray, row_edges: np.ndarray, col_edges: np.nda
     return ProjectionPlan(row_edges, col_edges)(plane)
 
 
+@contextmanager
+def one_opencv_thread():
+    """Run OpenCV on one thread inside: per-frame reductions and small images (~0.1 ms) are too
+    short for its pool to pay for its hand-offs, and the decoder thread already keeps every core
+    busy. Measured on 1080p H.264, 2 cores: 0.25 ms a frame on one thread against 0.75 on two (2-3
+    ms with other work on the cores); `wallcli count` 15 % and `stplot` 22 % less wall time
+    (bench/RESULTS.md, session 10). Restored on leaving (0.4 us a toggle), so a program using
+    wallcli as a library keeps its own OpenCV threading."""
+    import cv2
+
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        yield
+    finally:
+        cv2.setNumThreads(threads)
+
+
 class LineShift:
     """How far the picture moved along one axis since the first frame, from its line sums: a
     column-sum profile moves with the picture, so correlating the profile's fine structure (a
@@ -247,6 +267,24 @@ class LineShift:
         frac = 0.5 * (a - d) / den if den < 0 else 0.0
         shift = float(k - m + np.clip(frac, -0.5, 0.5))
         return shift if abs(shift) >= self.MIN else 0.0
+
+
+class LumaShift:
+    """A frame's (dx, dy) since the first frame, from its luma ROI's column and row sums
+    (:class:`LineShift` on each), for callers that do not sum the lines already (the SNR
+    estimator; the projector reuses its own sums)."""
+
+    def __init__(self) -> None:
+        self._x, self._y = LineShift(), LineShift()
+
+    def __call__(self, luma: np.ndarray) -> tuple[float, float]:
+        import cv2
+
+        with one_opencv_thread():
+            # every 4th row: a vertical feature's column profile is the same, at a quarter of the cost
+            cols = cv2.reduce(luma[::4], 0, cv2.REDUCE_SUM, dtype=cv2.CV_32F)[0]
+            rows = cv2.reduce(luma, 1, cv2.REDUCE_SUM, dtype=cv2.CV_32F)[:, 0]
+        return self._x(cols), self._y(rows)
 
 
 class _FusedProjection:
@@ -386,9 +424,6 @@ class RgbProjector:
     """
 
     def __init__(self, roi: Roi, bins: int, vertical: bool = True, stabilize: bool = False, register: bool = False):
-        import cv2
-
-        self._cv2 = cv2
         self.vertical = bool(vertical)
         self.stabilize = bool(stabilize)
         self.register = bool(register)
@@ -401,19 +436,8 @@ class RgbProjector:
         self._key = None
 
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
-        # One OpenCV thread for these reductions: a plane's column sums (~0.1 ms) are too short
-        # for OpenCV's pool to pay for its hand-offs, and the decoder thread already keeps every
-        # core busy. Measured on 1080p H.264, 2 cores: 0.25 ms a frame on one thread against 0.75
-        # on two (2-3 ms with other work on the cores); `wallcli count` 15 % and `stplot` 22 % less
-        # wall time (bench/RESULTS.md, session 10). Restored after each frame (0.4 us a toggle), so
-        # a program using wallcli as a library keeps its own OpenCV threading.
-        cv2 = self._cv2
-        threads = cv2.getNumThreads()
-        cv2.setNumThreads(1)
-        try:
+        with one_opencv_thread():
             return self._project(planes)
-        finally:
-            cv2.setNumThreads(threads)
 
     def _project(self, planes) -> tuple[np.ndarray, np.ndarray]:
         key = (planes.u is None, planes.sub_x, planes.sub_y, planes.kind, planes.depth, planes.matrix,

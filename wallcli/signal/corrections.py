@@ -30,7 +30,8 @@ shape a person does not make:
 findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
 ``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``; a
 step that a window's end cut wherever it was seen, taken as a ramp there, carries ``"partial": True``).
-A slot for camera shake (``kind: "shake"``) belongs beside these, before the block sums.
+Camera shake (``kind: "shake"``) is regressed out first, where the stream measured each frame's
+shift (:mod:`wallcli.signal.shake`, in :func:`correct_windows`).
 """
 from __future__ import annotations
 
@@ -57,10 +58,7 @@ UNEVEN = 0.2  # a bin's change within this fraction of the common one (plus its 
 UNEVEN_DRIFT = 0.4  # the same for drift: a passing shadow bends a bin's slow curve (a cubic) a little
 AGREE = 0.7  # fraction of the bins (mean over the profiles) that must change alike for a step or drift
 AGREE_EACH = 0.5  # and in each profile
-PAIRS = True  # two quick ramps a few tenths apart, with a level between, judged as one step
 AGREE_GROUPS = 8  # the fewest groups of neighbouring bins a profile is judged on
-CENTRE = True  # a step is placed at its ramp's middle, the ramp as long as measured
-OPEN_ENDS = True  # a step too close to the window's end to be measured is taken as a ramp there
 
 
 @dataclass(frozen=True)
@@ -401,7 +399,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         if ok:
             others = stepped()
             hj = half
-            where = _ramp(g - others, w, j, half, span) if CENTRE else None
+            where = _ramp(g - others, w, j, half, span)
             if where is not None and where[1] - where[0] <= ramp:
                 # the largest difference of adjacent means can sit at a slow ramp's end, so that
                 # the ramp left out of the fits (a ramp's length, centred on the step) misses half
@@ -417,7 +415,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
                         j = mid
                         nb, na = counts(j)
             if _rise(g - others, w, j, half, span) > ramp + 3:
-                two = _pair(g - others, w, j, ramp, span) if PAIRS else None
+                two = _pair(g - others, w, j, ramp, span)
                 hj = max(j - two[0], two[1] - j) if two is not None else -1
             ok = hj >= 0
             if ok:
@@ -438,7 +436,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
         for i, j in enumerate(found):
             if any(abs(j - k) < halves[i] + hk + span for k, hk in zip(found, halves) if k != j):
                 sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
-    ends = _open_ends(g, rel, w, basis, found, thr, noise, sigma, half + least + 1, part) if OPEN_ENDS else []
+    ends = _open_ends(g, rel, w, basis, found, thr, noise, sigma, half + least + 1, part)
     for lo, hi, _, _ in ends:
         w[lo:hi] = 0.0
     steps_g = stepped()

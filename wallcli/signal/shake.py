@@ -126,14 +126,10 @@ class ShakeSums:
         self.dxdx += np.outer(step, step)
         self.frames += 1
 
-    def flush(self) -> None:
-        """Nothing is buffered (kept for the estimator's call before its sums are read)."""
-
     def finding(self, sd: np.ndarray, dsum: np.ndarray, dxd: np.ndarray) -> dict[str, Any] | None:
         """The shake found, judged as :func:`unshake` does, on blocks' changes (``sd``, ``dsum``:
         their sums of squared differences and of differences; ``dxd``: their (5, ...) sums of
         dX d), or None: then leave the sums."""
-        self.flush()
         t = self.frames
         if t <= 4 * TERMS:
             return None

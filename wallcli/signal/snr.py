@@ -230,7 +230,7 @@ class SnrAccumulator:
         self.frames = 0
         self.warnings: list[str] = []
         self.options = corrections if corrections is not None and corrections.light and fps else None
-        self.shake = bool(corrections is not None and getattr(corrections, "shake", False))
+        self.shake = corrections is not None and corrections.shake
         self._shake = None  # ShakeSums, set up with the first frame
         self._found_shake = None
         self.fps = fps
@@ -250,10 +250,10 @@ class SnrAccumulator:
         lat = self.lattice
         self.levels = [n for n in self.scales if lat.th // n >= 1 and lat.tw // n >= 1]
         if self.shake and SHAKE_BLOCK in self.levels:
-            from wallcli.signal.blocks import LineShift
+            from wallcli.signal.blocks import LumaShift
             from wallcli.signal.shake import ShakeSums
 
-            self._lines = (LineShift(), LineShift())
+            self._register = LumaShift()
             self._shake = ShakeSums((3, lat.nty, lat.th // SHAKE_BLOCK, lat.ntx, lat.tw // SHAKE_BLOCK))
         if self.options is not None:
             from collections import deque
@@ -299,23 +299,6 @@ class SnrAccumulator:
         found = self.gains.corrections() if self.gains is not None else []
         return found + ([self._found_shake] if self._found_shake else [])
 
-    def _shift(self, planes) -> tuple[float, float]:
-        """The frame's (dx, dy) from the ROI's luma line sums (:class:`~wallcli.signal.blocks.LineShift`)."""
-        import cv2
-
-        x, y, w, h = self.roi
-        luma = planes.y[y:y + h, x:x + w]
-        # one OpenCV thread, as blocks.RgbProjector: its pool's hand-offs cost more than these sums
-        threads = cv2.getNumThreads()
-        cv2.setNumThreads(1)
-        try:
-            # every 4th row: a vertical feature's column profile is the same, at a quarter of the cost
-            cols = cv2.reduce(luma[::4], 0, cv2.REDUCE_SUM, dtype=cv2.CV_32F)[0]
-            rows = cv2.reduce(luma, 1, cv2.REDUCE_SUM, dtype=cv2.CV_32F)[:, 0]
-        finally:
-            cv2.setNumThreads(threads)
-        return self._lines[0](cols), self._lines[1](rows)
-
     def _profile(self, x: np.ndarray) -> np.ndarray:
         """Row-band then column-band sums of the measured pixels (colours summed)."""
         rows = x.sum(axis=(0, 3, 4)).reshape(-1)
@@ -341,7 +324,8 @@ class SnrAccumulator:
             self._setup(planes)
             self._ready = True
         x = self._rgb(planes)
-        shift = self._shift(planes) if self._shake is not None else None
+        x0, y0, w, h = self.roi
+        shift = self._register(planes.y[y0:y0 + h, x0:x0 + w]) if self._shake is not None else None
         if self.gains is None:
             self._add(x, shift)
             return
@@ -425,7 +409,6 @@ class SnrAccumulator:
                 if xc is not None:
                     xc, dxd = np.stack([_halve(a) for a in xc]), np.stack([_halve(a) for a in dxd])
             if n == SHAKE_BLOCK and sh is not None:
-                sh.flush()
                 xc, dxd = sh.xc.reshape((-1,) + s1.shape), sh.dxd.reshape((-1,) + s1.shape)
             per_level[n] = (s1, dsum, xc, dxd)
         if sh is not None and self.levels:

@@ -269,13 +269,10 @@ class ViewCheck:
     def update(self, t: float, planes) -> None:
         """Watch the frame at time ``t`` for a cut, and check it in full unless one was checked
         less than 1/CHECK_RATE s before (and nothing suspect was seen since)."""
-        import cv2
+        from wallcli.signal.blocks import one_opencv_thread
 
-        # one OpenCV thread: these images are too small for its pool's hand-offs to pay, and the
-        # decoder keeps the cores busy (as in signal.blocks.RgbProjector)
-        threads = cv2.getNumThreads()
-        cv2.setNumThreads(1)
-        try:
+        # these images are too small for OpenCV's pool's hand-offs to pay (blocks.one_opencv_thread)
+        with one_opencv_thread():
             cut = self._watch_cut(t, planes) if self._cut_t is None or t - self._cut_t >= 1.0 / CUT_RATE - 1e-3 else None
             if cut is not None:
                 self._mark("scene cut", cut)
@@ -284,8 +281,6 @@ class ViewCheck:
                 return
             self._t_checked = t
             self._update(t, planes)
-        finally:
-            cv2.setNumThreads(threads)
 
     def _watch_cut(self, t: float, planes) -> float | None:
         """The time of the previous sample if it was a cut: much of the frame changed from the
