@@ -63,11 +63,11 @@ def describe(ident: dict) -> str:
 
 
 def _model(task: str, threads: int):
-    from wallcli.infer.model import load_model
+    from wallcli.infer.twostage import load_classifier
 
     key = (task, threads)
-    if key not in _MODELS:
-        _MODELS[key] = load_model(task, threads=threads)
+    if key not in _MODELS:  # count: in two stages, as `wallcli count` answers
+        _MODELS[key] = load_classifier(task, threads=threads)
     return _MODELS[key]
 
 

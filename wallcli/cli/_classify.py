@@ -21,6 +21,11 @@ JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (
 PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
                         "(for a video, the plot drawn is averaged down to at most 2048 time columns).")
 MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
+ACTIVITY_MODEL_OPT = typer.Option(None, "--activity-model", help="The activity model of the two-stage count's "
+                                  "presence stage (default: the shipped one). Answers are decided only with the "
+                                  "pair the count card was calibrated with.")
+SINGLE_STAGE_OPT = typer.Option(False, "--single-stage", help="Count with the count net alone (the paper's "
+                                "design: the horizontal plot only), not in two stages.")
 THREADS_OPT = threads_option("onnxruntime intra-op threads (0: onnxruntime chooses).")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
@@ -35,7 +40,7 @@ NO_SHAKE_OPT = shake_option()
 def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
-        no_shake: bool = False) -> None:
+        no_shake: bool = False, activity_model: Optional[Path] = None, single_stage: bool = False) -> None:
     from wallcli.errors import UsageError
 
     roi_t = parse_roi(roi)
@@ -46,12 +51,13 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         raise UsageError("--follow reads live video; a .npz space-time plot is already complete")
 
     from wallcli.cli.output import emit_json, progress
-    from wallcli.infer.model import load_model
     from wallcli.io.writer import check_outputs, committed_together
 
     # the model is an input too: --plot over it must not replace it
-    check_outputs([plot], force=force, inputs=[input, model_path])
-    model = load_model(task, model_path, threads=threads)
+    check_outputs([plot], force=force, inputs=[input, model_path, activity_model])
+    from wallcli.infer.twostage import load_classifier
+
+    model = load_classifier(task, model_path, threads=threads, activity_path=activity_model, single=single_stage)
     stride = int(stride or model.card["stride"])
 
     if follow:

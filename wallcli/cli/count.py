@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
-from wallcli.cli._classify import (FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
+from wallcli.cli._classify import (ACTIVITY_MODEL_OPT, SINGLE_STAGE_OPT, FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
                                    STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT, run)
 
 
@@ -22,13 +22,17 @@ def count(
     no_deflicker: bool = NO_DEFLICKER_OPT,
     no_exposure: bool = NO_EXPOSURE_OPT,
     no_shake: bool = NO_SHAKE_OPT,
+    activity_model: Optional[Path] = ACTIVITY_MODEL_OPT,
+    single_stage: bool = SINGLE_STAGE_OPT,
 ) -> None:
     """Count the people (0, 1 or 2) moving out of view, from the light on a blank wall.
 
-    The horizontal space-time plot is cut into 256-frame windows (8.5 s at 30 fps, any
-    input frame rate is resampled); the paper's CNN classifies each (Sharma et al., What You
-    Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §2); the clip's answer is
-    the mean of the window probabilities.
+    The space-time plots are cut into 256-frame windows (8.5 s at 30 fps, any input frame
+    rate is resampled). Two stages answer: is anybody moving (the count net, which reads the
+    horizontal plot as the paper's does, and the activity net, which reads both plots, as two
+    detectors), then one or two (the count net). The clip's answer combines each net's mean
+    window probabilities; the JSON's "stages" says what each stage found. --single-stage
+    counts with the count net alone (Sharma et al., ICCV 2021, supplementary §2).
 
     \b
     Examples:
@@ -39,4 +43,5 @@ def count(
     """
     run("count", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,
-        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake)
+        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake,
+        activity_model=activity_model, single_stage=single_stage)

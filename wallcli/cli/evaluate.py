@@ -34,6 +34,10 @@ def evaluate(
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
     no_shake: bool = shake_option(),
+    activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="--task count: the activity model "
+                                                  "of the two-stage count's presence stage (default: the shipped one)."),
+    single_stage: bool = typer.Option(False, "--single-stage", help="--task count: score the count net alone, not "
+                                      "the two-stage count that 'wallcli count' answers with."),
 ) -> None:
     """Score a model on labelled clips: the check to run before relying on it for a room.
 
@@ -79,11 +83,12 @@ def evaluate(
     plan = plan_folder(folder, task, min_snr=min_snr)  # fails early (exit 1) on a folder without labels
     for file, why in plan.labels.damaged:
         warn(f"{file} skipped: {why}")
-    check_outputs([plot], force=force, inputs=[model, *(c.path for c in plan.labels.clips)])
+    check_outputs([plot], force=force, inputs=[model, activity_model, *(c.path for c in plan.labels.clips)])
     # delayed: on a small folder a bar would only flash; on a large one it shows the minutes left
     with progress(f"evaluate {task}", len(plan.kept), delay=PROGRESS_DELAY) as advance:
         result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan,
-                                 corrections=corrections_of(no_deflicker, no_exposure, no_shake))
+                                 corrections=corrections_of(no_deflicker, no_exposure, no_shake),
+                                 activity_path=activity_model, single=single_stage)
     if plot is not None:
         from wallcli.plots.reliability import save_reliability_png
 

@@ -73,7 +73,8 @@ def measure_clip(model, path: str | Path, *, stride: int, roi=None, threads: int
 _WORKER: dict[str, Any] = {}
 
 
-def init_worker(task: str, model_path: str, stride: int, roi, corrections=None) -> None:
+def init_worker(task: str, model_path: str, stride: int, roi, corrections=None, activity_path=None,
+                single: bool = False) -> None:
     """Per process: the model loaded (and hash-checked) once, onnxruntime on one thread (the
     processes share out the cores). Ctrl-C is the parent's to handle: it stops the pool."""
     import os
@@ -81,9 +82,10 @@ def init_worker(task: str, model_path: str, stride: int, roi, corrections=None) 
 
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    from wallcli.infer.model import Model
+    from wallcli.infer.twostage import load_classifier
 
-    _WORKER.update(model=Model.load(model_path, task=task, threads=1), stride=stride, roi=roi, corrections=corrections)
+    model = load_classifier(task, model_path, threads=1, activity_path=activity_path, single=single)
+    _WORKER.update(model=model, stride=stride, roi=roi, corrections=corrections)
 
 
 def run_clip(path: str) -> dict[str, Any]:

@@ -53,17 +53,19 @@ def default_jobs() -> int:
 
 def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | None = None, roi=None,
                     jobs: int = 0, progress: Callable[[int], None] | None = None, min_snr: float | None = None,
-                    plan: Plan | None = None, corrections=None) -> dict[str, Any]:
+                    plan: Plan | None = None, corrections=None, activity_path: str | Path | None = None,
+                    single: bool = False) -> dict[str, Any]:
     """Run ``task``'s model (the shipped one, or ``model_path``) on every labelled clip of ``folder``
     in ``jobs`` processes (0: one per core) and score it. A clip that fails is a row with its
     error (and a wrong answer); labels that cannot be read raise WallcliError. ``min_snr``: score
     only empty rooms and clips whose SNR (the labels', else the measured one) is at least that;
     a clip whose SNR is unknown (it failed) is left out too. ``plan``: :func:`plan_folder`'s, when
     the caller has made it already (its min_snr then holds)."""
-    from wallcli.infer.model import load_model
+    from wallcli.infer.twostage import load_classifier
 
     plan = plan or plan_folder(folder, task, min_snr=min_snr)
-    model = load_model(task, model_path)  # checked here once: a bad model fails before any worker starts
+    # checked here once: a bad model fails before any worker starts; count is two-stage unless single
+    model = load_classifier(task, model_path, activity_path=activity_path, single=single)
     classes = model.classes
     kept = plan.kept
     for c in kept:
@@ -83,7 +85,8 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
                 progress(1)
     if todo:
         n = jobs or default_jobs()
-        initargs = (task, str(model.path), stride, tuple(roi) if roi else None, corrections)
+        initargs = (task, str(model.path), stride, tuple(roi) if roi else None, corrections,
+                    str(model.activity.path) if not model.single else None, model.single)
         with closing(imap_isolated(run_clip, [str(kept[i].path) for i in todo], jobs=n,
                                    initializer=init_worker, initargs=initargs)) as results:
             for k, value in results:
@@ -105,9 +108,14 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
         why = [f"{len(plan.skipped)} skipped"] + ([f"{len(excluded)} under --min-snr {plan.min_snr:g} dB"]
                                                   if plan.min_snr is not None else [])
         raise WallcliError(f"{folder}: no clip to score ({', '.join(why)})")
-    return report(rows, task=task, model=model.info(), classes=classes, folder=str(folder), labels=plan.labels.source,
-                  skipped=plan.skipped, stride=stride, roi=roi, snr_source="labels" if has_snr else "measured",
-                  min_snr=plan.min_snr, excluded=excluded)
+    from wallcli.infer.twostage import stages_info
+
+    out = report(rows, task=task, model=model.info(), classes=classes, folder=str(folder), labels=plan.labels.source,
+                 skipped=plan.skipped, stride=stride, roi=roi, snr_source="labels" if has_snr else "measured",
+                 min_snr=plan.min_snr, excluded=excluded)
+    if stages_info(model) is not None:  # count in two stages: with which activity model
+        out["stages"] = stages_info(model)
+    return out
 
 
 def _row(clip: Clip, out: dict, task: str, has_snr: bool) -> dict[str, Any]:

@@ -30,14 +30,28 @@ def _too_short(source: str, frames: int, model) -> WallcliError:
         f"one window needs {model.window} frames ({model.window / model.fps:.2f} s)")
 
 
-def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> dict[str, Any]:
+def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None]:
+    block = model.card.get("confidence")
+    confident, reason = judge(block, probs, signal_db, model.classes)
+    if not block and model.no_block_reason():
+        reason = model.no_block_reason()
+    return confident, reason
+
+
+def _window_record(model, start: float, raw: np.ndarray, signal_db: float) -> dict[str, Any]:
+    """One window's answer from the model's raw output for it (for a two-stage count, both nets')."""
+    probs = model.combine(raw)[0]
     k = int(np.argmax(probs))
     # judged on the figure the JSON carries, so that the reason quotes exactly that figure
     signal_db = round(float(signal_db), 2)
-    confident, reason = judge(model.card.get("confidence"), probs, signal_db, model.classes)
-    return {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
-            "label": model.classes[k], "probabilities": [float(p) for p in probs],
-            "confident": confident, "reason": reason, "signal_db": signal_db}
+    confident, reason = _judge(model, probs, signal_db)
+    rec = {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
+           "label": model.classes[k], "probabilities": [float(p) for p in probs],
+           "confident": confident, "reason": reason, "signal_db": signal_db}
+    stages = model.stages(raw)
+    if stages is not None:
+        rec["stages"] = stages
+    return rec
 
 
 def resampled_plots(model, plot, both: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
@@ -56,11 +70,12 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str, found=N
     """The docs/contract.md result from window start times, their probabilities (n, classes),
     measured signals (n,) in dB and what each window's corrections found (``found``)."""
     found = found if found is not None else [[] for _ in times]
-    clip = probs.mean(axis=0)
+    raw = probs.mean(axis=0)  # each net's mean over the windows (a two-stage count combines these)
+    clip = model.combine(raw)[0]
     clip = clip / clip.sum()
     clip_db = round(float(np.mean(signal_db)), 2)
-    confident, reason = judge(model.card.get("confidence"), clip, clip_db, model.classes)
-    return {
+    confident, reason = _judge(model, clip, clip_db)
+    out = {
         "input": source,
         "task": model.task,
         "model": model.info(),
@@ -77,6 +92,11 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str, found=N
         "windows": [_window_record(model, t, pr, db) | {"corrections": corr.merge([f])}
                     for t, pr, db, f in zip(times, probs, signal_db, found)],
     }
+    if model.stages(raw) is not None:  # a two-stage count: what each stage found for the clip
+        from wallcli.infer.twostage import stages_info
+
+        out["stages"] = stages_info(model) | model.stages(raw)
+    return out
 
 
 def native_fps(time) -> float | None:
@@ -120,7 +140,7 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
                              starts=[grid[s] for s in chunk])
         found += f
         wins = {name: wins[name] for name in model.input_names}
-        probs.append(model.predict({name: model.normalize(w, offsets[name][None]) for name, w in wins.items()}))
+        probs.append(model.classify(wins, {name: offsets[name][None] for name in wins}))
         signal.append(window_signal_db([(w, offsets[name][None]) for name, w in wins.items()]))
     return _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
                    stride=stride, source=source, found=found)
@@ -141,7 +161,7 @@ def _predict_window(model, win: np.ndarray, ref: np.ndarray, *, start: float = 0
     use = [n for n in ("horizontal", "vertical") if n in model.input_names or (options.any and np.any(parts[n]))]
     wins, found = _corrected(model, {n: parts[n][None] for n in use}, refs, native, options, starts=[start],
                              shifts=shifts)
-    probs = model.predict({n: model.normalize(wins[n], refs[n]) for n in model.input_names})[0]
+    probs = model.classify({n: wins[n] for n in model.input_names}, refs)[0]
     return probs, float(window_signal_db([(wins[n], refs[n]) for n in model.input_names])[0]), found[0]
 
 

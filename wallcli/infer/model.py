@@ -91,6 +91,23 @@ class Model:
     def info(self) -> dict[str, str]:
         return {"name": self.card["name"], "version": self.card["version"], "sha256": self.card["sha256"]}
 
+    # -- the classifier interface of infer/classify.py (shared with infer/twostage.TwoStageCount)
+    single = True  # one net: its raw output is its answer
+
+    def classify(self, wins: dict[str, np.ndarray], offsets: dict[str, np.ndarray]) -> np.ndarray:
+        """Class probabilities (n, classes) of raw plot windows {name: (n, bins, window, 3)}, each
+        normalised as this model's card says against its level ``offsets[name]`` (..., bins, 3)."""
+        return self.predict({n: self.normalize(wins[n], offsets[n]) for n in self.input_names})
+
+    def combine(self, raw: np.ndarray) -> np.ndarray:
+        return np.atleast_2d(raw)
+
+    def stages(self, raw: np.ndarray) -> None:
+        return None
+
+    def no_block_reason(self) -> None:
+        return None
+
     # -- session ----------------------------------------------------------------------
     @property
     def session(self):

@@ -107,6 +107,10 @@ def load_models(count_model=None, activity_model=None, threads: int = 0) -> dict
     if models["count"].bins != models["activity"].bins:
         raise UsageError(f"the count model reads {models['count'].bins} bins and the activity model "
                          f"{models['activity'].bins}; a report draws both from one space-time plot")
+    from wallcli.infer.twostage import TwoStageCount
+
+    # count in two stages, as `wallcli count` answers: presence from both nets, then how many
+    models["count"] = TwoStageCount(models["count"], models["activity"])
     return models
 
 

@@ -1,0 +1,141 @@
+"""Count in two stages: is anybody there (both nets), then how many (the count net).
+
+The count net reads the horizontal plot only (the seed's design); a person crouching, waving or
+jumping in place shows mostly in the vertical plot and as a whole-wall flicker, which that net
+reads as nobody. The activity net reads both plots. So:
+
+- stage 1, presence: the two nets are two detectors of "nobody moves" (count p(0), activity
+  p(none)); their evidence is combined as a product of experts with even priors,
+  p_nobody = a b / (a b + (1 - a)(1 - b));
+- stage 2, how many: the rest of the probability is shared between one and two people as the
+  count net shares it, p(n) = (1 - p_nobody) c_n / (c_1 + c_2).
+
+The rule was fixed before any measurement (research/twostage/README.md, session 15): nothing in
+it is fitted. On the transfer set it moved count from 50 to 57 of 96 detectable clips there
+(paired McNemar p = 0.04); the shipped figures are in models/README.md.
+
+Clip answers combine the clip's mean probabilities of each net (the mean of its windows, as each
+command answers alone); window answers combine that window's. Whether an answer is decided comes
+from the count card's ``two_stage.confidence`` block, fitted on the combined answers of this very
+pair of models; with another activity model (or a count card without the block) the pair has no
+validated thresholds, and every answer is undetermined rather than guessed.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+
+RULE = ("presence: product of experts of the count net's p(0) and the activity net's p(none), even priors; "
+        "how many: the count net's p(1) against p(2)")
+NO_PAIR_REASON = ("no validated confidence thresholds for this pair of count and activity models "
+                  "(the count card's two_stage block names another activity model, or none)")
+
+
+def combine(pc: np.ndarray, pa: np.ndarray) -> np.ndarray:
+    """(n, 3) count probabilities from the count net's (n, 3) and the activity net's (n, 5)."""
+    pc = np.asarray(pc, np.float64)
+    pa = np.asarray(pa, np.float64)
+    a, b = pc[:, 0], pa[:, 0]
+    den = a * b + (1 - a) * (1 - b)
+    nobody = np.where(den > 0, a * b / np.maximum(den, 1e-300), 0.5)
+    some = np.maximum(pc[:, 1] + pc[:, 2], 1e-300)
+    out = np.stack([nobody, (1 - nobody) * pc[:, 1] / some, (1 - nobody) * pc[:, 2] / some], axis=1)
+    return out / out.sum(axis=1, keepdims=True)
+
+
+class TwoStageCount:
+    """The count task's classifier: quacks like :class:`wallcli.infer.model.Model` for
+    :mod:`wallcli.infer.classify` (task, classes, inputs, window, fps, card), but its raw output
+    per window is both nets' probabilities side by side (3 + 5 columns); :meth:`combine` turns
+    them into the count answer and :meth:`stages` says what each stage found."""
+
+    def __init__(self, count, activity):
+        for attr in ("fps", "window", "bins"):
+            if getattr(count, attr) != getattr(activity, attr):
+                raise WallcliError(f"the count and activity models differ in {attr} "
+                                   f"({getattr(count, attr)} against {getattr(activity, attr)}): they cannot be combined",
+                                   hint="pass --single-stage to count with the count model alone")
+        if count.task != "count" or activity.task != "activity":
+            raise WallcliError("a two-stage count needs a count model and an activity model")
+        self.count, self.activity = count, activity
+        block = count.card.get("two_stage") if isinstance(count.card.get("two_stage"), dict) else {}
+        pair = block.get("activity_model", {}) if isinstance(block.get("activity_model"), dict) else {}
+        self.calibrated = pair.get("sha256") == activity.card["sha256"] and isinstance(block.get("confidence"), dict)
+        self.card = dict(count.card)
+        self.card["confidence"] = block.get("confidence") if self.calibrated else None
+        self.card["two_stage"] = block
+        self.path = count.path
+
+    task = "count"
+    single = False
+
+    @property
+    def classes(self) -> list[Any]:
+        return self.count.classes
+
+    @property
+    def input_names(self) -> list[str]:
+        names = set(self.count.input_names) | set(self.activity.input_names)
+        return [n for n in ("horizontal", "vertical") if n in names]
+
+    window = property(lambda self: self.count.window)
+    bins = property(lambda self: self.count.bins)
+    fps = property(lambda self: self.count.fps)
+
+    def info(self) -> dict[str, str]:
+        return self.count.info()
+
+    def classify(self, wins: dict[str, np.ndarray], offsets: dict[str, np.ndarray]) -> np.ndarray:
+        """Raw output (n, 8): the count net's 3 probabilities, then the activity net's 5."""
+        return np.concatenate([self.count.classify(wins, offsets), self.activity.classify(wins, offsets)], axis=1)
+
+    def combine(self, raw: np.ndarray) -> np.ndarray:
+        raw = np.atleast_2d(raw)
+        return combine(raw[:, :3], raw[:, 3:])
+
+    def no_block_reason(self) -> str | None:
+        return None if self.calibrated else NO_PAIR_REASON
+
+    def stages(self, raw: np.ndarray) -> dict[str, Any]:
+        """What each stage found for one answer (its raw row, or the clip's mean raw row)."""
+        raw = np.asarray(raw, np.float64)
+        p = self.combine(raw)[0]
+        somebody = float(1 - p[0])
+        some = max(float(raw[1] + raw[2]), 1e-300)
+        return {"presence": round(somebody, 6),
+                # stage 2: one or two people, given somebody moves (the count net's share)
+                "how_many": [round(float(raw[1]) / some, 6), round(float(raw[2]) / some, 6)],
+                "count": [round(float(v), 6) for v in raw[:3]],
+                "activity": [round(float(v), 6) for v in raw[3:]],
+                # the stage that made the label: nobody is the presence stage's answer, one or two
+                # people the count stage's (once the presence stage said somebody moves)
+                "decided_by": "presence" if int(np.argmax(p)) == 0 else "count"}
+
+
+def stages_info(model) -> dict[str, Any] | None:
+    """The result's description of a two-stage model (None for a single model)."""
+    if not isinstance(model, TwoStageCount):
+        return None
+    return {"rule": RULE, "activity_model": model.activity.info(), "calibrated": model.calibrated}
+
+
+def load_count(path=None, *, activity_path=None, threads: int = 0, single: bool = False):
+    """The count classifier: the two-stage pair (default) or the count net alone (``single``)."""
+    from wallcli.infer.model import load_model
+
+    count = load_model("count", path, threads=threads)
+    if single:
+        return count
+    return TwoStageCount(count, load_model("activity", activity_path, threads=threads))
+
+
+def load_classifier(task: str, path=None, *, threads: int = 0, activity_path=None, single: bool = False):
+    """What a command classifies ``task`` with: count in two stages unless ``single``."""
+    from wallcli.infer.model import load_model
+
+    if task == "count":
+        return load_count(path, activity_path=activity_path, threads=threads, single=single)
+    return load_model(task, path, threads=threads)
