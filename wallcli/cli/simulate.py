@@ -63,7 +63,9 @@ def simulate(
     domain: str = typer.Option("base", "--domain", help="base: training ranges; shifted: moved ranges of room size, lights, "
                                "clothing, body size, camera (an honest held-out validation set); wide: both and more (windows, ceiling "
                                "panels, small frames, lighting nuisances in half the clips, periodic waving and jumping half the "
-                               "time); steady: wide with steady light in most rooms (nuisances in a sixth)."),
+                               "time); steady: wide with steady light in most rooms (nuisances in a sixth); bracket: steady with the bodies' "
+                               "radiance (0.3-1.5x) and the shadows they cast on the room (0.5-3x) drawn per scene, so that "
+                               "the analytic world brackets a path tracer's signal."),
     distance: str = typer.Option("1,5", "--distance", help="MIN,MAX distance of people from the wall (m)."),
     speed: str = typer.Option("0.5,1.8", "--speed", help="MIN,MAX walking speed (m/s)."),
     level: Optional[float] = number_option(None, "--level", lo=5, hi=250, help="Mean wall brightness in 8-bit codes (default: random from the seed)."),
@@ -103,7 +105,8 @@ def simulate(
     shard_scenes: int = number_option(32, "--shard-scenes", lo=1, hi=100_000, integer=True, help="Scenes per shard file."),
     placement: str = typer.Option("visible", "--placement", help="Dataset mode: where people go. visible: 0.8-4 m from the "
                                   "wall, walkers within 1.5 m of the observed patch (their signal stands above the noise); "
-                                  "anywhere: 1-5 m, roaming 2.5 m, like single videos."),
+                                  "anywhere: 1-5 m, roaming 2.5 m, like single videos; wide: 1-5 m, roaming 2 m; transfer: as wide, but "
+                                  "people moving in place 1-3 m from the wall, where real footage shows them."),
 ) -> None:
     """Render synthetic blank-wall videos with known ground truth, or datasets for training.
 
@@ -124,14 +127,14 @@ def simulate(
 
     if world not in ("room", "flatland", "mixed", "pt"):
         raise UsageError(f"--world must be room, flatland, pt or mixed (got {world!r})")
-    if domain not in ("base", "shifted", "wide", "steady"):
-        raise UsageError(f"--domain must be base, shifted, wide or steady (got {domain!r})")
+    if domain not in ("base", "shifted", "wide", "steady", "bracket"):
+        raise UsageError(f"--domain must be base, shifted, wide, steady or bracket (got {domain!r})")
     grid_rc = _size(grid, "--grid", 512) if grid else ((24, 32) if dataset is not None else (64, 64))
     # checked in both modes, so that a mistyped value is never silently ignored
     if task not in ("count", "activity"):
         raise UsageError(f"--task must be count or activity (got {task!r})")
-    if placement not in ("visible", "anywhere", "wide"):
-        raise UsageError(f"--placement must be visible, anywhere or wide (got {placement!r})")
+    if placement not in ("visible", "anywhere", "wide", "transfer"):
+        raise UsageError(f"--placement must be visible, anywhere, wide or transfer (got {placement!r})")
     if dataset is not None:
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")

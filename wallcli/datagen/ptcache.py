@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wallcli.datagen.clips import PLACEMENTS, WINDOW, FPS, scene_plan
+from wallcli.datagen.clips import FPS, WINDOW, placement_of, scene_plan
 
 FORMAT = "wallcli.pt-clean-scene"
 VERSION = 1
@@ -35,10 +35,6 @@ SEEDS = 8  # sampler seeds cycled over the frames (and empty-room renders per sc
 ALONE_STEP = 3  # two-person scenes: each person alone rendered every ALONE_STEP frames (for the SNR fit)
 # frame rates of the footage the models meet (the transfer set's labels: 24 and 30 fps), plus 25
 RATES = (24.0, 25.0, 30.0)
-# 'transfer' placement: walkers as 'wide' (1-5 m, roaming 2 m); people moving in place 1-3 m from
-# the wall, close enough to be seen, as the transfer set's crouchers, wavers and jumpers are
-# (their median snr_db 3-9 dB; 'wide' put 89 % of them under the noise)
-IN_PLACE = {"distance": (1.0, 3.0), "roam": 2.0}
 
 
 def cache_root() -> Path:
@@ -47,10 +43,15 @@ def cache_root() -> Path:
 
 
 def recipe(*, seed: int, task: str = "count", domain: str = "wide", placement: str = "transfer",
-           grid=(16, 24), spp: int = 64) -> dict:
-    return {"format": FORMAT, "version": VERSION, "seed": int(seed), "task": task, "domain": domain,
-            "placement": placement, "grid": [int(g) for g in grid], "spp": int(spp), "seeds": SEEDS,
-            "rates": list(RATES), "alone_step": ALONE_STEP}
+           grid=(16, 24), spp: int = 64, duration: float | None = None) -> dict:
+    """What decides a cached scene besides its index; ``duration`` (s) fixes every scene's length
+    (default: one window and 1.5-6 s more, as dataset mode draws it)."""
+    rec = {"format": FORMAT, "version": VERSION, "seed": int(seed), "task": task, "domain": domain,
+           "placement": placement, "grid": [int(g) for g in grid], "spp": int(spp), "seeds": SEEDS,
+           "rates": list(RATES), "alone_step": ALONE_STEP}
+    if duration is not None:
+        rec["duration"] = float(duration)
+    return rec
 
 
 def folder(rec: dict, root: Path | None = None) -> Path:
@@ -65,13 +66,9 @@ def _config(rec: dict, index: int):
     rng = np.random.default_rng(np.random.SeedSequence([rec["seed"], int(index), 7]))
     people, acts, label = scene_plan(rng, rec["task"], rec["domain"])
     duration = WINDOW / FPS + rng.uniform(1.5, 6.0)
+    duration = float(rec.get("duration") or duration)
     fps = float(rng.choice(RATES))
-    place = dict(PLACEMENTS["wide"])
-    if rec["placement"] == "transfer":
-        if acts and all(a != "walking" for a in acts):
-            place = dict(IN_PLACE)
-    elif rec["placement"] in PLACEMENTS:
-        place = dict(PLACEMENTS[rec["placement"]])
+    place = placement_of(rec["placement"], acts)
     cfg = SceneConfig(people=people, activities=acts or None, duration=duration, grid=tuple(rec["grid"]),
                       domain=rec["domain"], world="pt", spp=rec["spp"], fps=fps, **place)
     return cfg, label

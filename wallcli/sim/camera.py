@@ -60,7 +60,7 @@ class CameraParams:
 def sample_camera(rng: np.random.Generator, domain: str = "base", *, nuisance_p: float = 0.35) -> CameraParams:
     """Random camera: from very clean (large ROI, low gain) to very noisy (small ROI, high ISO)."""
     if domain in WIDE_DOMAINS:
-        return _sample_wide_camera(rng, nuisance_p=0.5 if domain == "wide" else 1 / 6)
+        return _sample_wide_camera(rng, nuisance_p=0.5 if domain == "wide" else 1 / 6)  # steady, bracket: a sixth
     shifted = domain == "shifted"
     w = int(rng.choice([128, 144, 160, 176, 192]) if not shifted else rng.choice([96, 112, 208, 224]))
     h = int(2 * round(w * rng.uniform(0.56, 0.8) / 2))

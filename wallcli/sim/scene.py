@@ -68,6 +68,9 @@ class Scene:
     # of each person's own (gx, 3) change. Dataset mode uses it to measure how visible the people
     # are in each window.
     clean_profiles: list | None = None
+    # 'bracket' domain: the bodies' radiance and their room shadows scaled (sim/__init__.py)
+    body_gain: float = 1.0
+    shadow_gain: float = 1.0
 
     @property
     def label_activity(self) -> str:
@@ -130,10 +133,12 @@ class Scene:
 
     def _delta(self, C, R, A, probes, view, bbox) -> np.ndarray:
         """The wall's irradiance change (gy, gx, 3) from spheres C, R, A in one frame."""
-        dE = body_delta(self.room, self.points, C, R, body_radiance(self.room, C, A, view), bbox,
-                        overlapping_pairs(probes, C, R))
+        L = body_radiance(self.room, C, A, view)
+        if self.body_gain != 1.0:
+            L = L * self.body_gain
+        dE = body_delta(self.room, self.points, C, R, L, bbox, overlapping_pairs(probes, C, R))
         if self.config.shadows:
-            dE = dE + shadow_delta(self.room, self.points, C, R, A)
+            dE = dE + self.shadow_gain * shadow_delta(self.room, self.points, C, R, A)
         return dE
 
     def _pt_frames(self) -> Iterator[np.ndarray]:
@@ -176,6 +181,8 @@ class Scene:
             "fps": self.camera.fps, "frames": n, "seed": self.seed, "width": self.camera.width,
             "height": self.camera.height, "domain": self.config.domain,
             **({"world": "pt", "spp": int(self.config.spp)} if self.config.world == "pt" else {}),
+            **({"body_gain": round(self.body_gain, 4), "shadow_gain": round(self.shadow_gain, 4)}
+               if self.config.domain == "bracket" else {}),
             "room": {"size_m": [round(W, 3), round(D, 3), round(H, 3)], "lamps": len(self.room.lamp_radius),
                      "lamp_positions": np.round(self.room.lamp_pos, 3).tolist(), "windows": len(self.room.windows)},
             "wall_region_m": [round(v, 3) for v in self.region],
@@ -255,5 +262,10 @@ def sample_scene(seed: int, config: SceneConfig | None = None, index: int | None
         people.append(bodies.sample_person(rng, config.domain))
         poses.append(motion.make_motion(rng, a, times, bounds if a == "walking" else spot_bounds, config.speed, cross.get(i, 0),
                                         config.domain))
-    return Scene(int(seed), config, room, cam, region, points,
-                 people, acts, poses, times, rng)
+    scene = Scene(int(seed), config, room, cam, region, points, people, acts, poses, times, rng)
+    if config.domain == "bracket":  # drawn last: every other draw is the 'steady' scene's
+        from wallcli.sim import BODY_GAIN, SHADOW_GAIN
+
+        scene.body_gain = float(np.exp(rng.uniform(*np.log(BODY_GAIN))))
+        scene.shadow_gain = float(np.exp(rng.uniform(*np.log(SHADOW_GAIN))))
+    return scene
