@@ -97,6 +97,18 @@ def test_memory_does_not_grow_with_the_number_of_issues():
     assert vc.view(0.0, 1.0)["issues"] == ["moving object"]
 
 
+def test_a_span_that_rounds_to_one_instant_reads_as_one_time():
+    """'camera motion at 0.6-0.6 s' read as a range of nothing: such a span is 'at 0.6 s'."""
+    from wallcli.signal.view import ViewCheck
+
+    vc = ViewCheck()
+    vc.frames = 1
+    vc.spans["camera motion"] = [(0.57, 0.62)]
+    vc.spans["moving object"] = [(1.0, 2.44)]
+    reason = vc.view()["reason"]
+    assert "camera motion at 0.6 s" in reason and "moving object at 1.0-2.4 s" in reason
+
+
 @pytest.fixture(scope="module")
 def crossing(tmp_path_factory):
     """10 s of wall with a person crossing the view (one window of count)."""

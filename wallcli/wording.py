@@ -22,6 +22,13 @@ def format_db(x) -> str:
     return "0.0" if text == "-0.0" else text
 
 
+def span_text(a: float, b: float) -> str:
+    """A time span as it reads: '0.6-1.4 s', or '0.6 s' when both ends round alike ('0.6-0.6 s'
+    read as a range of nothing)."""
+    lo, hi = f"{a:.1f}", f"{b:.1f}"
+    return f"{lo} s" if lo == hi else f"{lo}-{hi} s"
+
+
 def plural(n: int, word: str, words: str | None = None) -> str:
     """'1 video', '2 videos' ('1 person', '3 people' with ``words``)."""
     return f"{n} {word if n == 1 else (words or word + 's')}"
