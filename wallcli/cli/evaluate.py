@@ -60,7 +60,8 @@ def evaluate(
     Examples:
       wallcli evaluate recordings/ --task count
       wallcli evaluate recordings/ --task activity --json | jq '.accuracy, .ci95'
-      wallcli evaluate recordings/ --task count --model new.onnx --plot reliability.png --jobs 4
+      wallcli evaluate recordings/ --task count --model new.onnx --jobs 4
+      wallcli evaluate recordings/ --task count --plot reliability.png
       wallcli evaluate recordings/ --task count --min-snr 0 --json | jq '.by_band'
     """
     from wallcli.errors import UsageError

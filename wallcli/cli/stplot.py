@@ -37,8 +37,8 @@ def stplot(
     \b
     Examples:
       wallcli stplot clip.mp4 -o plots.npz --png plots.png
-      wallcli stplot clip.mp4 --roi 100,50,640,360 --png wall.png --style diverging
-      ffmpeg -i rtsp://cam/stream -f nut - | wallcli stplot - --mean ema -o live.npz
+      wallcli stplot clip.mp4 --roi 100,50,640,360 --png w.png --style diverging
+      ffmpeg -i rtsp://cam/s -f nut - | wallcli stplot - --mean ema -o live.npz
     """
     from wallcli.errors import UsageError
 
