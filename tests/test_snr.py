@@ -245,6 +245,28 @@ def test_predict_sweep(run_cli, tmp_path):
     assert run_cli("snr", "--predict", "--sweep", "height=1:2:1")[0] == 2
 
 
+@pytest.mark.parametrize("camera, quantity", [((), "signal power"), (("--mean-code", 120, "--gain", 4), "SNR")])
+def test_a_sweep_plot_names_what_it_plots(run_cli, tmp_path, monkeypatch, camera, quantity):
+    """Without a camera model the sweep plots signal power: the line on stderr, the axis and the
+    title say so (stderr said 'predicted SNR' over a figure of signal power), with the x unit."""
+    import wallcli.plots.snr as plots
+
+    seen = {}
+    real = plots.save_figure
+
+    def keep(fig, path, **kw):
+        ax = fig.axes[0]
+        seen.update(x=ax.get_xlabel(), y=ax.get_ylabel(), title=ax.get_title(loc="left"))
+        return real(fig, path, **kw)
+
+    monkeypatch.setattr(plots, "save_figure", keep)
+    code, _, err = run_cli("snr", "--predict", "--sweep", "distance=1:4:1", *camera, "--plot", tmp_path / "p.png")
+    assert code == 0, err
+    assert f"predicted {quantity} against distance" in err
+    assert seen["y"].startswith(f"predicted {quantity}") and quantity in seen["title"]
+    assert seen["x"] == "distance (m)"
+
+
 # ------------------------------------------------------------------------------------ bad input
 def test_bad_input(run_cli, tmp_path, gaussian_clip):
     path, _, _ = gaussian_clip

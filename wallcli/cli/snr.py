@@ -52,7 +52,7 @@ def snr(
     heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
-                                        "with --predict --sweep, SNR (or signal power) against the swept parameter."),
+                                        "with --predict --sweep, SNR against the swept parameter (signal power without --mean-code and --gain)."),
     max_pixels: int = number_option(32768, "--max-pixels", lo=0, hi=2**31, integer=True, help="Pixels measured per frame: a larger ROI is sampled by a regular "
                                    "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
                                    "decode speed). 0 = every pixel of the ROI (exact, slower)."),
@@ -304,10 +304,10 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
     if plot is not None:
         from wallcli.plots.snr import save_sweep_png
 
-        save_sweep_png(plot, key, rows, force=force)
+        what = save_sweep_png(plot, key, rows, force=force)
         from wallcli.cli.output import wrote
 
-        wrote((plot, f"predicted SNR against {key.replace('_', '-')}"))
+        wrote((plot, f"predicted {what} against {key.replace('_', '-')}"))
     if json_out:
         emit_json({"mode": "predict", "parameters": settings, "sweep": {"parameter": key.replace("_", "-"), "values": values},
                    "rows": rows})
