@@ -267,6 +267,26 @@ def test_a_sweep_plot_names_what_it_plots(run_cli, tmp_path, monkeypatch, camera
     assert seen["x"] == "distance (m)"
 
 
+def test_a_verdict_comes_first_and_tells_an_empty_room_from_a_walker(run_cli):
+    """The 1x1 row reads 4.0 dB on the empty example and 4.1 dB on the walker: the first line says
+    which one carries a wall signal (the one whose SNR grows with averaging) and at which block."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    seen = {}
+    for name in ("empty", "walking"):
+        code, out, err = run_cli("snr", examples / f"{name}.mp4")
+        assert code == 0, err
+        first = out.splitlines()[0]
+        assert first.startswith("Verdict: ") and len(first) <= 80
+        code, out, _ = run_cli("snr", examples / f"{name}.mp4", "--json")
+        seen[name] = json.loads(out)["verdict"]
+        assert seen[name]["text"] in " ".join(first.split())
+    assert seen["empty"]["signal"] is False and "no wall signal" in seen["empty"]["text"]
+    assert seen["walking"]["signal"] is True and seen["walking"]["block"] > 1
+    assert f"{seen['walking']['block']}x{seen['walking']['block']}" in seen["walking"]["text"]
+
+
 # ------------------------------------------------------------------------------------ bad input
 def test_bad_input(run_cli, tmp_path, gaussian_clip):
     path, _, _ = gaussian_clip

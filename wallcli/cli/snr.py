@@ -124,7 +124,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     import warnings
 
     from wallcli.cli.common import parse_roi
-    from wallcli.cli.output import emit_json, print_table, progress, warn, wrote
+    from wallcli.cli.output import emit_json, print_lines, print_table, progress, warn, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
@@ -188,6 +188,9 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         refuse_view(input, result["view"])
     res = acc.result()
     notes = result["warnings"]
+    from wallcli.signal.snr_verdict import snr_verdict
+
+    result["verdict"] = snr_verdict(result)
     if auto:
         result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
                           "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0)),
@@ -211,6 +214,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         warn(n)
     if not result["view"]["usable"]:  # the figures below then measure more than a wall's light
         warn(result["view"]["reason"])
+    print_lines([f"Verdict: {result['verdict']['text']}."])
     how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
@@ -219,6 +223,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         [[f"{s['block']}x{s['block']}", _triple(s["signal_power"]), _triple(s["noise_power"]),
           _triple(s["snr_db"], format_db, 5)] for s in result["scales"]],
     )
+    print_lines([f"Why the verdict: {result['verdict']['why']}."])
 
 
 def _triple(v, fmt=None, width: int = 7) -> str:
