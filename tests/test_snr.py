@@ -161,10 +161,10 @@ def test_cli_json_contract_and_figures(run_cli, gaussian_clip, tmp_path):
 
 def test_roi_auto_finds_the_signal_patch(run_cli, tmp_path):
     rng = np.random.default_rng(5)
-    patch = (48, 18, 30, 30)  # x, y, w, h; on the 6-pixel candidate grid of a 96x64 frame
+    patch = (70, 10, 70, 70)  # x, y, w, h; on the 10-pixel candidate grid of a 160x96 frame, >= 64 px a side
 
     def fn(i):
-        img = 90.0 + rng.normal(0, 1.0, (64, 96, 3))
+        img = 90.0 + rng.normal(0, 1.0, (96, 160, 3))
         x, y, w, h = patch
         img[y:y + h, x:x + w] += 3.0 * np.sin(2 * np.pi * i / PERIOD)
         return img
@@ -184,7 +184,7 @@ def test_roi_auto_avoids_a_mover_in_view(run_cli, tmp_path):
     """A dark object pacing in the left of the view changes its pixels far more than the faint
     patch on the right: the view check marks where it went, and --roi auto picks the patch."""
     rng = np.random.default_rng(6)
-    patch = (120, 48, 48, 48)  # x, y, w, h in a 192x128 frame
+    patch = (108, 36, 72, 72)  # x, y, w, h in a 192x128 frame (12-pixel cells; --roi auto takes >= 64 px)
     wall = 110.0 + 4.0 * rng.normal(0, 1.0, (128, 192, 1))  # some texture: an object has edges on it
 
     def fn(i):
@@ -208,6 +208,21 @@ def test_roi_auto_avoids_a_mover_in_view(run_cli, tmp_path):
     px, py, pw, ph = patch
     inter = max(0, min(x + w, px + pw) - max(x, px)) * max(0, min(y + h, py + ph) - max(y, py))
     assert inter / (w * h) > 0.5, data["roi"]
+
+
+def test_roi_auto_never_picks_a_sliver(run_cli):
+    """On examples/walking.mp4 --roi auto chose a 10x40 px strip, which the plots' 64 bins
+    spread over 10 pixels (count then said 2, not 1): the ROI is at least 64 px a side, as
+    --help states."""
+    from pathlib import Path
+
+    clip = Path(__file__).resolve().parents[1] / "examples" / "walking.mp4"
+    code, out, err = run_cli("snr", clip, "--roi", "auto", "--json")
+    assert code == 0, err
+    x, y, w, h = json.loads(out)["roi"]
+    assert w >= 64 and h >= 64, (x, y, w, h)
+    code, out, _ = run_cli("snr", "--help")
+    assert "at least 64 px on each side" in " ".join(out.split())
 
 
 def test_predict_equals_closed_forms(run_cli):

@@ -34,6 +34,7 @@ PREDICT_PARAMS = {
     "frames": ("--frames", 1.0, "Camera model: frames averaged.", dict(lo=1, hi=1e9)),
 }
 MAX_SWEEP = 10000
+AUTO_MIN_PX = 64  # --roi auto's smallest side: the space-time plots' 64 bins, one pixel each
 
 
 def _predict_option(name: str):
@@ -47,7 +48,8 @@ def snr(
                                       "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
                                       "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
                                       "covariances), leaving out cells where the view check saw a moving object, clipping or black. "
-                                      "'auto' reads the file twice. Default: whole frame."),
+                                      f"'auto' reads the file twice and is at least {AUTO_MIN_PX} px on each side (the "
+                                      "frame's side if smaller), so the plots' 64 bins hold a pixel each. Default: whole frame."),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object (docs/contract.md fields, plus extras) on stdout."),
     heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
@@ -152,12 +154,15 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
                     whole(frame)
                     advance()
         avoid = whole.avoid(grid.grid_roi, grid.rows, grid.cols)
+        # a sliver makes fractional, overlapping bins of the same few pixels (a 10 px strip of
+        # walking.mp4 turned count's 1 into 2): at least one pixel per bin, or the whole frame's side
+        smallest = (-(-AUTO_MIN_PX // grid.ch), -(-AUTO_MIN_PX // grid.cw))
         try:
-            roi_t, auto_snr = grid.best_roi(avoid)
+            roi_t, auto_snr = grid.best_roi(avoid, min_cells=smallest)
         except ValueError:
             notes.append("--roi auto: the view failed somewhere in every part of the frame (a mover "
                          "or clipping); the ROI was chosen as if it had not")
-            roi_t, auto_snr = grid.best_roi()
+            roi_t, auto_snr = grid.best_roi(min_cells=smallest)
             avoid[:] = False
         if avoid.any():
             notes.append(f"--roi auto left out {int(avoid.sum())} of {avoid.size} cells where the view check saw "
