@@ -46,6 +46,19 @@ def test_stplot_npz_format_and_streak(tmp_path, run_cli):
     assert np.allclose(v.mean(axis=2), v.mean(axis=(0, 2))[None, :], atol=0.15)
 
 
+def test_stplot_warns_when_the_roi_is_narrower_than_its_bins(tmp_path, run_cli):
+    """A 10 px strip cut into 64 bins gives bins that share pixels: said on stderr and in the
+    JSON's warnings; an ROI with a pixel per bin is not warned about."""
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30, pix_fmt="yuv444p")
+    code, stdout, err = run_cli("stplot", clip, "--json", "--roi", "40,0,10,48")
+    assert code == 0, err
+    said = " ".join(err.split())
+    assert "Warning:" in said and "10 px wide" in said and "64 bins" in said
+    assert any("10 px wide" in w for w in json.loads(stdout)["warnings"])
+    code, stdout, err = run_cli("stplot", clip, "--json", "--roi", "0,0,96,48", "--bins", "32")
+    assert code == 0 and "bins" not in err and json.loads(stdout)["warnings"] == []
+
+
 def test_stplot_png_and_styles(tmp_path, run_cli):
     clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
     for style in ("rgb", "diverging"):
