@@ -67,6 +67,7 @@ SECTIONS = {"count": "`wallcli count INPUT --json`", "activity": "`wallcli activ
             "scan": "`wallcli scan INPUT... -o results.jsonl`"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(SECTIONS))
 def test_every_field_the_shipped_contract_names_is_written(name, outputs):
     sections = _sections()

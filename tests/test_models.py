@@ -24,6 +24,7 @@ def golden_clip(tmp_path_factory):
     return clip
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", ["count", "activity"])
 def test_golden_outputs(task, golden_clip, run_cli):
     golden = json.loads((GOLDEN / f"{task}.json").read_text())

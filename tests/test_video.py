@@ -185,6 +185,7 @@ def test_writer_round_trip(tmp_path, name, codec):
     assert np.abs(np.array(got) - np.array([f[0, 0] for f in frames])).max() < 1.5
 
 
+@pytest.mark.slow
 def test_repeatable_writer_gives_the_same_h264_file_every_time(tmp_path):
     """The simulator's promise (a seed gives one video) rests on this: x264's AVX-512 code was
     measured giving a different file on most encodes of the same faint, smooth frames, and its

@@ -2,7 +2,7 @@
 
 A decibel figure: one decimal, and never "-0.0". JSON keeps more digits. Every table, reason and page writes this rounding of the JSON's own value,
 so one figure reads the same wherever it appears (a reason saying "19 dB" beside a ``signal_db``
-of 18.6 looked like a second measurement). What each dB figure measures: README, "Which SNR is
+of 18.6 looked like a second measurement). What each dB figure measures: docs/outputs.md, "Which SNR is
 which".
 """
 from __future__ import annotations
