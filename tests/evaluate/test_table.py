@@ -60,7 +60,8 @@ def test_sixty_clips_fit_80_columns_one_line_each(monkeypatch, capsys):
             assert shown == ([r["label"], "?"] if r["confident"] is False else [r["label"]])
             assert ("yes" if r["correct"] else "no") in cells and cells[-1] == f"{r['snr_db']:.1f}"
     rest = "\n".join(lines[top + 61:])
-    assert rest.startswith("?: undetermined") and "SNR dB: measured" in " ".join(rest.split())
+    above = " ".join(" ".join(lines[order[-2]:order[-1]]).split())  # between the confusion and the clips
+    assert "?: undetermined" in above and "SNR dB: measured" in above  # the columns' meaning heads the table
     assert "97% right only from" not in "\n".join(lines) and "[1]" not in "\n".join(lines)
     assert "Invalid data found" in rest and "1 clip skipped: more than one person" in "\n".join(lines)
     assert len(lines) <= 60 + 50  # one line a clip, plus the figures

@@ -54,11 +54,12 @@ def _clips(res: dict, show_det: bool) -> None:
             row.insert(1, {True: "yes", False: "no", None: "?"}[r["detectable"]])
         rows.append(row)
     m = res["model"]
-    print_table(f"{res['task']} by {m['name']} {m['version']}, per clip", cols, rows, pad_edge=False)
     what = ("labels.csv snr_db (the bands' SNR)" if labels else
             "measured block SNR of the green channel over one plot bin's area (the bands' SNR)")
+    # what the columns mean above them, the title last: it is one unwrapped line right over its table
     print_lines(["?: undetermined, the most likely answer shown (why: --json, rows[].reason); "
                  f"p %: its probability; SNR dB: {what}" + ("; det: labelled detectable" if show_det else "")])
+    print_table(f"{res['task']} by {m['name']} {m['version']}, per clip", cols, rows, pad_edge=False)
     failed: dict[str, int] = {}
     for r in res["rows"]:
         if r["error"] is not None:
