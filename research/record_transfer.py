@@ -33,7 +33,7 @@ def main() -> None:
     # the set by what it is: the folder it sits in here means nothing to a reader of the card
     block = {"description": f"independent path-traced transfer set, {result.get('clips')} clips, the headline figures on "
                             f"the {result.get('scored')} where the people are above the camera's noise or the room is "
-                            "empty, by_band on all (not shipped with wallcli)",
+                            "empty, the SNR bands on all (not shipped with wallcli)",
              **{k: result[k] for k in KEYS if k in result}}
     block["source"] = ("an independent path-traced renderer (other code, box people, area lights, its own camera "
                        "model), never trained or calibrated on")

@@ -64,3 +64,13 @@ def test_unknown_option_is_a_one_line_usage_error(run_cli):
     code, out, err = run_cli("stplot", "x.mp4", "--no-such-option")
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and err.startswith("Error:")
+
+
+@pytest.mark.parametrize("name", [None, *COMMANDS])
+def test_help_fits_80_columns(run_cli, name, monkeypatch):
+    """Examples are kept as written (click's \\b): none may run past an 80-column terminal."""
+    monkeypatch.setenv("COLUMNS", "80")
+    code, out, _ = run_cli(*([name] if name else []), "--help")
+    assert code == 0
+    long = [line for line in out.splitlines() if len(line) > 80]
+    assert not long, long

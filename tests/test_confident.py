@@ -3,6 +3,9 @@ import json
 
 import pytest
 
+# every test here reads three simulated clips (about a minute): see pyproject's 'slow' marker
+pytestmark = pytest.mark.slow
+
 STRONG = ["--people", "1", "--activity", "walking", "--seed", "11", "--size", "128x96", "--duration", "10.5",
           "--fps", "30", "--distance", "1,1.6", "--crf", "0", "--iso-gain", "0.02", "--read-noise", "0.5",
           "--sensor-pixels", "1000000"]

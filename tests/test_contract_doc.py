@@ -69,6 +69,7 @@ SECTIONS = {"count": "`wallcli count INPUT --json`", "activity": "`wallcli activ
             "count_stages": "`wallcli count INPUT --json`: the two stages"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(SECTIONS))
 def test_every_field_the_shipped_contract_names_is_written(name, outputs):
     sections = _sections()

@@ -267,6 +267,7 @@ def _analyse(path, on=True):
     return out, scales[block]["snr_db"][GREEN]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["flicker", "rolling", "exposure"])
 def test_answers_and_snr_of_the_clean_clip_are_kept(clips, kind):
     clean, clean_snr = _analyse(clips["walker", "none"])

@@ -55,3 +55,19 @@ def test_activity_on_examples(clip, run_cli):
 def test_known_wrong_names_real_clips():
     stems = {c.stem for c in CLIPS}
     assert {clip for _, clip in KNOWN_WRONG} <= stems
+
+
+def test_count_and_activity_agree_on_the_empty_room(run_cli):
+    """One trust rule: 'nobody moves' is decided by neither task, so both leave the empty example
+    undetermined for the same reason (activity 0.3.1's card certified 'none' at its 3 dB of codec
+    residue, count 0.4.1's card did not)."""
+    clip = EXAMPLES / "empty.mp4"
+    answers = {}
+    for task in ("count", "activity"):
+        code, out, err = run_cli(task, clip, "--json")
+        assert code == 0, err
+        answers[task] = json.loads(out)
+    assert answers["count"]["label"] == 0 and answers["activity"]["label"] == "none"
+    for r in answers.values():
+        assert r["confident"] is False and "is never decided" in r["reason"]
+        assert not any(w["confident"] for w in r["windows"])

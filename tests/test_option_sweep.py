@@ -205,6 +205,7 @@ def _clear(work: Path) -> None:
         p.rmdir() if p.is_dir() and not p.is_symlink() else p.unlink()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_every_option_with_hostile_values(name, inputs, tmp_path, monkeypatch, capsys):
     folder, paths = inputs

@@ -2,6 +2,7 @@
 
 import cv2
 import numpy as np
+import pytest
 
 from clips import write_clip
 from wallcli.io.video import open_video
@@ -15,6 +16,7 @@ def _plot_corr(plot: np.ndarray, truth: np.ndarray) -> float:
     return float((x * t).sum() / np.sqrt((x * x).sum() * (t * t).sum()))
 
 
+@pytest.mark.slow
 def test_subcode_sinusoid_survives_stplot_but_not_uint8_resize(tmp_path):
     # 720p, the size where a 64-bin uint8 resize averages so many pixels (~225) that the noise
     # no longer dithers the rounding and the 0.2-code-value signal is rounded away.

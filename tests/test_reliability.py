@@ -17,6 +17,9 @@ from wallcli.cli.common import MAX_THREADS
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
+# the clip is 32x24 px: fewer pixels than 64 bins is warned about, and these tests count stderr lines
+FEW_BINS = ("--bins", "16")
+
 
 def _wall(i):
     return np.full((24, 32, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (24, 32, 3))
@@ -81,13 +84,13 @@ def test_stplot_png_failure_leaves_no_npz(tmp_path, run_cli, clip, monkeypatch):
         raise WallcliError("the PNG could not be drawn")
 
     monkeypatch.setattr(plots, "save_stplot_png", broken)
-    code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz", "--png", tmp_path / "p.png")
+    code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz", "--png", tmp_path / "p.png", *FEW_BINS)
     assert code == 1 and "could not be drawn" in _one_error(err)
     assert _files(tmp_path) == {"c.mkv"}
 
 
 def test_stplot_gain_at_its_bound_draws(tmp_path, run_cli, clip):
-    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "p.png", "--gain", "1e6", "--style", "diverging")
+    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "p.png", "--gain", "1e6", "--style", "diverging", *FEW_BINS)
     assert code == 0 and "Warning" not in err, err
     assert (tmp_path / "p.png").stat().st_size > 0
 
@@ -150,7 +153,7 @@ def _run_with_stdout(stdout, argv):
 
 @pytest.mark.parametrize("stdout", [_FullStdout(), None], ids=["full", "closed"])
 def test_stdout_that_fails_is_one_error_line_and_no_output_file(tmp_path, capsys, clip, stdout):
-    code = _run_with_stdout(stdout, ["stplot", clip, "-o", tmp_path / "p.npz", "--json"])
+    code = _run_with_stdout(stdout, ["stplot", clip, "-o", tmp_path / "p.npz", "--json", *FEW_BINS])
     err = capsys.readouterr().err
     reason = "no space left on device" if stdout is not None else "it is closed"
     assert code == 1 and _one_error(err) == f"Error: cannot write to stdout: {reason}"
@@ -166,7 +169,7 @@ def test_count_table_to_a_full_stdout(tmp_path, capsys):
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
 def test_real_full_and_closed_stdout(tmp_path, clip):
-    cmd = [sys.executable, "-m", "wallcli", "stplot", str(clip), "-o", str(tmp_path / "p.npz"), "--json"]
+    cmd = [sys.executable, "-m", "wallcli", "stplot", str(clip), "-o", str(tmp_path / "p.npz"), "--json", *FEW_BINS]
     with open("/dev/full", "w") as full:
         res = subprocess.run(cmd, stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
     assert res.returncode == 1 and res.stderr == "Error: cannot write to stdout: no space left on device\n"

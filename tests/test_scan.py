@@ -71,6 +71,7 @@ def _by_input(lines: list[dict], root: Path) -> dict:
     return {str(Path(d["input"]).relative_to(root)): d for d in lines}
 
 
+@pytest.mark.slow
 def test_scan_answers_what_the_single_video_commands_answer(folder, single, tmp_path, run_cli):
     out = tmp_path / "results.jsonl"
     code, stdout, err = run_cli("scan", folder, "-o", out, "--workers", "2", "--json")
@@ -132,6 +133,7 @@ def _children(pid: int) -> list:
         return []
 
 
+@pytest.mark.slow
 def test_resume_after_a_kill_loses_and_repeats_nothing(folder, tmp_path, run_cli):
     import psutil
 
@@ -216,6 +218,7 @@ def _wait_for(path: Path, proc, seconds: float = 60) -> None:
         time.sleep(0.1)
 
 
+@pytest.mark.slow
 def test_scheduler_runs_the_same_tasks_and_checks_its_workers(folder, single, tmp_path, run_cli):
     sfile = tmp_path / "scheduler.json"
     dask = [sys.executable, "-m", "dask"]

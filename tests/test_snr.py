@@ -161,10 +161,10 @@ def test_cli_json_contract_and_figures(run_cli, gaussian_clip, tmp_path):
 
 def test_roi_auto_finds_the_signal_patch(run_cli, tmp_path):
     rng = np.random.default_rng(5)
-    patch = (48, 18, 30, 30)  # x, y, w, h; on the 6-pixel candidate grid of a 96x64 frame
+    patch = (70, 10, 70, 70)  # x, y, w, h; on the 10-pixel candidate grid of a 160x96 frame, >= 64 px a side
 
     def fn(i):
-        img = 90.0 + rng.normal(0, 1.0, (64, 96, 3))
+        img = 90.0 + rng.normal(0, 1.0, (96, 160, 3))
         x, y, w, h = patch
         img[y:y + h, x:x + w] += 3.0 * np.sin(2 * np.pi * i / PERIOD)
         return img
@@ -184,7 +184,7 @@ def test_roi_auto_avoids_a_mover_in_view(run_cli, tmp_path):
     """A dark object pacing in the left of the view changes its pixels far more than the faint
     patch on the right: the view check marks where it went, and --roi auto picks the patch."""
     rng = np.random.default_rng(6)
-    patch = (120, 48, 48, 48)  # x, y, w, h in a 192x128 frame
+    patch = (108, 36, 72, 72)  # x, y, w, h in a 192x128 frame (12-pixel cells; --roi auto takes >= 64 px)
     wall = 110.0 + 4.0 * rng.normal(0, 1.0, (128, 192, 1))  # some texture: an object has edges on it
 
     def fn(i):
@@ -208,6 +208,21 @@ def test_roi_auto_avoids_a_mover_in_view(run_cli, tmp_path):
     px, py, pw, ph = patch
     inter = max(0, min(x + w, px + pw) - max(x, px)) * max(0, min(y + h, py + ph) - max(y, py))
     assert inter / (w * h) > 0.5, data["roi"]
+
+
+def test_roi_auto_never_picks_a_sliver(run_cli):
+    """On examples/walking.mp4 --roi auto chose a 10x40 px strip, which the plots' 64 bins
+    spread over 10 pixels (count then said 2, not 1): the ROI is at least 64 px a side, as
+    --help states."""
+    from pathlib import Path
+
+    clip = Path(__file__).resolve().parents[1] / "examples" / "walking.mp4"
+    code, out, err = run_cli("snr", clip, "--roi", "auto", "--json")
+    assert code == 0, err
+    x, y, w, h = json.loads(out)["roi"]
+    assert w >= 64 and h >= 64, (x, y, w, h)
+    code, out, _ = run_cli("snr", "--help")
+    assert "at least 64 px on each side" in " ".join(out.split())
 
 
 def test_predict_equals_closed_forms(run_cli):
@@ -243,6 +258,48 @@ def test_predict_sweep(run_cli, tmp_path):
     code, out, _ = run_cli("snr", "--predict", "--sweep", "read-noise=1:3:1", "--mean-code", 50, "--gain", 2)
     assert code == 0 and "read-noise" in out
     assert run_cli("snr", "--predict", "--sweep", "height=1:2:1")[0] == 2
+
+
+@pytest.mark.parametrize("camera, quantity", [((), "signal power"), (("--mean-code", 120, "--gain", 4), "SNR")])
+def test_a_sweep_plot_names_what_it_plots(run_cli, tmp_path, monkeypatch, camera, quantity):
+    """Without a camera model the sweep plots signal power: the line on stderr, the axis and the
+    title say so (stderr said 'predicted SNR' over a figure of signal power), with the x unit."""
+    import wallcli.plots.snr as plots
+
+    seen = {}
+    real = plots.save_figure
+
+    def keep(fig, path, **kw):
+        ax = fig.axes[0]
+        seen.update(x=ax.get_xlabel(), y=ax.get_ylabel(), title=ax.get_title(loc="left"))
+        return real(fig, path, **kw)
+
+    monkeypatch.setattr(plots, "save_figure", keep)
+    code, _, err = run_cli("snr", "--predict", "--sweep", "distance=1:4:1", *camera, "--plot", tmp_path / "p.png")
+    assert code == 0, err
+    assert f"predicted {quantity} against distance" in err
+    assert seen["y"].startswith(f"predicted {quantity}") and quantity in seen["title"]
+    assert seen["x"] == "distance (m)"
+
+
+def test_a_verdict_comes_first_and_tells_an_empty_room_from_a_walker(run_cli):
+    """The 1x1 row reads 4.0 dB on the empty example and 4.1 dB on the walker: the first line says
+    which one carries a wall signal (the one whose SNR grows with averaging) and at which block."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    seen = {}
+    for name in ("empty", "walking"):
+        code, out, err = run_cli("snr", examples / f"{name}.mp4")
+        assert code == 0, err
+        first = out.splitlines()[0]
+        assert first.startswith("Verdict: ") and len(first) <= 80
+        code, out, _ = run_cli("snr", examples / f"{name}.mp4", "--json")
+        seen[name] = json.loads(out)["verdict"]
+        assert seen[name]["text"] in " ".join(first.split())
+    assert seen["empty"]["signal"] is False and "no wall signal" in seen["empty"]["text"]
+    assert seen["walking"]["signal"] is True and seen["walking"]["block"] > 1
+    assert f"{seen['walking']['block']}x{seen['walking']['block']}" in seen["walking"]["text"]
 
 
 # ------------------------------------------------------------------------------------ bad input

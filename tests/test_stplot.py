@@ -46,6 +46,36 @@ def test_stplot_npz_format_and_streak(tmp_path, run_cli):
     assert np.allclose(v.mean(axis=2), v.mean(axis=(0, 2))[None, :], atol=0.15)
 
 
+def test_stplot_warns_when_the_roi_is_narrower_than_its_bins(tmp_path, run_cli):
+    """A 10 px strip cut into 64 bins gives bins that share pixels: said on stderr and in the
+    JSON's warnings; an ROI with a pixel per bin is not warned about."""
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30, pix_fmt="yuv444p")
+    code, stdout, err = run_cli("stplot", clip, "--json", "--roi", "40,0,10,48")
+    assert code == 0, err
+    said = " ".join(err.split())
+    assert "Warning:" in said and "10 px wide" in said and "64 bins" in said
+    assert any("10 px wide" in w for w in json.loads(stdout)["warnings"])
+    code, stdout, err = run_cli("stplot", clip, "--json", "--roi", "0,0,96,48", "--bins", "32")
+    assert code == 0 and "bins" not in err and json.loads(stdout)["warnings"] == []
+
+
+def test_the_figure_title_writes_full_scale_as_plus_minus(tmp_path, run_cli, monkeypatch):
+    """'full scale = +-0.513' read as code; the title says '\u00b10.51' (two digits)."""
+    import re
+
+    import wallcli.plots.stplot as plots
+
+    titles = []
+    real = plots.save_figure
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path, **kw: titles.append(fig.axes[0].get_title(loc="left"))
+                        or real(fig, path, **kw))
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
+    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "p.png")
+    assert code == 0, err
+    assert "+-" not in titles[0] and re.search(r"full scale \u00b1\d(\.\d+)? code values", titles[0]), titles[0]
+    assert not re.search(r"\u00b1\d\.\d{3}", titles[0])
+
+
 def test_stplot_png_and_styles(tmp_path, run_cli):
     clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
     for style in ("rgb", "diverging"):

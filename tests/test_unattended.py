@@ -390,7 +390,7 @@ def test_read_only_and_full_file_systems(tmp_path, clip, run_cli):
             assert code == 1 and ("read-only" in _one_error(err) or "not writable" in err)
     with _tmpfs(tmp_path / "full", "size=64k") as full:
         (full / "fill").write_bytes(b"\0" * 60_000)
-        code, _, err = run_cli("stplot", clip, "-o", full / "p.npz", "--png", full / "p.png")
+        code, _, err = run_cli("stplot", clip, "-o", full / "p.npz", "--png", full / "p.png", "--bins", "16")
         assert code == 1 and "no space left on device" in _one_error(err)
         assert sorted(p.name for p in full.iterdir()) == ["fill"]
 

@@ -124,6 +124,23 @@ def test_stdin_stream(tmp_path):
     assert out.stdout.split() == ["12", "48", "32"]
 
 
+def test_an_mp4_on_stdin_is_refused_naming_what_streams(tmp_path):
+    """An MP4's index sits at its end, where a pipe cannot seek: `cat clip.mp4 | wallcli count -`
+    says so and names the containers that stream (it said 'the stream is damaged' before)."""
+    rng = np.random.default_rng(0)
+    # noise, so that the file outgrows what FFmpeg probes before it would need the index
+    path = write_clip(tmp_path / "s.mp4", lambda i: rng.uniform(0, 255, (128, 160, 3)), 40,
+                      options={"crf": "0", "preset": "ultrafast"})
+    with open(path, "rb") as fh:
+        out = subprocess.run([sys.executable, "-m", "wallcli", "count", "-"], stdin=fh, capture_output=True,
+                             text=True, timeout=120)
+    assert out.returncode == 1
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: ") and "damaged" not in lines[0]
+    assert "MP4 cannot be streamed" in lines[0]
+    assert all(name in lines[0] for name in ("MPEG-TS", "Matroska", "NUT", "Y4M"))
+
+
 @pytest.mark.parametrize("content", [b"", b"this is not a video\n" * 10])
 def test_unreadable_files(tmp_path, content):
     path = tmp_path / "bad.mp4"
@@ -168,6 +185,7 @@ def test_writer_round_trip(tmp_path, name, codec):
     assert np.abs(np.array(got) - np.array([f[0, 0] for f in frames])).max() < 1.5
 
 
+@pytest.mark.slow
 def test_repeatable_writer_gives_the_same_h264_file_every_time(tmp_path):
     """The simulator's promise (a seed gives one video) rests on this: x264's AVX-512 code was
     measured giving a different file on most encodes of the same faint, smooth frames, and its

@@ -52,6 +52,7 @@ def _fault(kind: str, seed: int, domain: str, seconds: float = SECONDS):
     return getattr(views, kind)(src, rng, n=n, fps=FPS, **kw)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("domain", ["base", "shifted", "wide", "steady"])
 def test_a_simulated_wall_is_a_usable_view(tmp_path, domain):
     view = _check(_encode(tmp_path / "w.mp4", _scene(11, domain)))
@@ -61,6 +62,7 @@ def test_a_simulated_wall_is_a_usable_view(tmp_path, domain):
 
 @pytest.mark.parametrize("kind, issue", [("sprite", "moving object"), ("pan", "camera motion"),
                                          ("shake", "camera motion"), ("cut", "scene cut")])
+@pytest.mark.slow
 def test_what_is_not_a_still_wall_is_refused_and_named(tmp_path, kind, issue):
     view = _check(_encode(tmp_path / "f.mp4", _fault(kind, 21, "base")))
     assert not view["usable"]
@@ -97,12 +99,25 @@ def test_memory_does_not_grow_with_the_number_of_issues():
     assert vc.view(0.0, 1.0)["issues"] == ["moving object"]
 
 
+def test_a_span_that_rounds_to_one_instant_reads_as_one_time():
+    """'camera motion at 0.6-0.6 s' read as a range of nothing: such a span is 'at 0.6 s'."""
+    from wallcli.signal.view import ViewCheck
+
+    vc = ViewCheck()
+    vc.frames = 1
+    vc.spans["camera motion"] = [(0.57, 0.62)]
+    vc.spans["moving object"] = [(1.0, 2.44)]
+    reason = vc.view()["reason"]
+    assert "camera motion at 0.6 s" in reason and "moving object at 1.0-2.4 s" in reason
+
+
 @pytest.fixture(scope="module")
 def crossing(tmp_path_factory):
     """10 s of wall with a person crossing the view (one window of count)."""
     return _encode(tmp_path_factory.mktemp("view") / "crossing.mp4", _fault("sprite", 5, "base", 10.0))
 
 
+@pytest.mark.slow
 def test_count_activity_snr_carry_the_view_and_refuse_a_crossing(run_cli, crossing):
     code, out, err = run_cli("count", crossing, "--json")
     assert code == 0, err
@@ -120,6 +135,7 @@ def test_count_activity_snr_carry_the_view_and_refuse_a_crossing(run_cli, crossi
         assert len(lines) == 1 and lines[0].startswith("Error:") and "moving object" in lines[0], err
 
 
+@pytest.mark.slow
 def test_a_wall_passes_strict(run_cli, tmp_path):
     clip = _encode(tmp_path / "wall.mp4", _scene(3, "steady", 10.0))
     code, out, err = run_cli("count", clip, "--json", "--strict")
@@ -128,6 +144,7 @@ def test_a_wall_passes_strict(run_cli, tmp_path):
     assert r["view"]["usable"] is True and all(w["view"]["usable"] for w in r["windows"])
 
 
+@pytest.mark.slow
 def test_scan_puts_the_view_on_the_line(crossing, tmp_path):
     from wallcli.batch.analyse import analyse
 
@@ -189,6 +206,7 @@ def test_a_bright_object_that_clips_is_a_moving_object(tmp_path):
     assert wall["usable"], wall
 
 
+@pytest.mark.slow
 def test_hard_shadows_of_people_near_the_wall_are_not_moving_objects(tmp_path):
     """Two hidden people 1-2 m from a wall in the 'steady' domain: their shadows change the wall
     by half its level with the codec's re-coding residue on top (10-25 % of the shadowed level in
@@ -202,6 +220,7 @@ def test_hard_shadows_of_people_near_the_wall_are_not_moving_objects(tmp_path):
     assert view["usable"], view
 
 
+@pytest.mark.slow
 def test_a_cut_between_alike_views_is_a_scene_cut(tmp_path):
     """A cut to a view of the same wall under another light: darker (a gain, which the check
     divides out as it would an exposure change) and lit up to 1.7 % more on one side and less on

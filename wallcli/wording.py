@@ -2,7 +2,7 @@
 
 A decibel figure: one decimal, and never "-0.0". JSON keeps more digits. Every table, reason and page writes this rounding of the JSON's own value,
 so one figure reads the same wherever it appears (a reason saying "19 dB" beside a ``signal_db``
-of 18.6 looked like a second measurement). What each dB figure measures: README, "Which SNR is
+of 18.6 looked like a second measurement). What each dB figure measures: docs/outputs.md, "Which SNR is
 which".
 """
 from __future__ import annotations
@@ -20,6 +20,13 @@ def format_db(x) -> str:
         return "-"
     text = f"{v:.1f}"
     return "0.0" if text == "-0.0" else text
+
+
+def span_text(a: float, b: float) -> str:
+    """A time span as it reads: '0.6-1.4 s', or '0.6 s' when both ends round alike ('0.6-0.6 s'
+    read as a range of nothing)."""
+    lo, hi = f"{a:.1f}", f"{b:.1f}"
+    return f"{lo} s" if lo == hi else f"{lo}-{hi} s"
 
 
 def plural(n: int, word: str, words: str | None = None) -> str:

@@ -42,6 +42,7 @@ def test_band_edges():
     assert band_of(False, 9.99) == "0-10 dB" and band_of(False, 10.0) == ">=10 dB" and band_of(False, None) == "not measured"
 
 
+@pytest.mark.slow
 def test_bands_from_the_labels_snr_cover_every_clip(with_snr, run_cli):
     code, out, err = run_cli("evaluate", with_snr, "--task", "count", "--json", "--jobs", "2")
     assert code == 0, err
@@ -65,6 +66,7 @@ def test_bands_from_the_labels_snr_cover_every_clip(with_snr, run_cli):
     assert "empty rooms 2" in text and "10 dB and over 1" in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("floor,out_", [("0", ["crouch.mp4"]), ("10", ["jump.mp4", "crouch.mp4"])])
 def test_min_snr_leaves_quiet_clips_out_of_every_figure(with_snr, run_cli, floor, out_):
     code, out, err = run_cli("evaluate", with_snr, "--task", "count", "--json", "--jobs", "2", "--min-snr", floor)
@@ -79,6 +81,7 @@ def test_min_snr_leaves_quiet_clips_out_of_every_figure(with_snr, run_cli, floor
     assert f"--min-snr {floor}: {len(out_)} clip{'s' if len(out_) > 1 else ''} under {floor} dB left out" in text
 
 
+@pytest.mark.slow
 def test_without_an_snr_column_bands_are_on_the_measured_snr(labelled, run_cli):
     code, out, err = run_cli("evaluate", labelled, "--task", "count", "--json", "--jobs", "2")
     assert code == 0, err
@@ -104,6 +107,7 @@ def test_without_an_snr_column_bands_are_on_the_measured_snr(labelled, run_cli):
     assert "The labels give no snr_db: bands are on the measured SNR" in _flat(out)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf", "100", "-1e9", "loud", ""])
 def test_min_snr_must_be_a_finite_number_in_range(with_snr, run_cli, value):
     code, out, err = run_cli("evaluate", with_snr, "--task", "count", "--min-snr", value)

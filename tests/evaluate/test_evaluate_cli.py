@@ -14,6 +14,7 @@ CONTRACT = ("task", "model", "dir", "clips", "scored", "errors", "accuracy", "ci
 ROW = ("file", "truth", "label", "confident", "probabilities", "snr_db", "detectable", "error")
 
 
+@pytest.mark.slow
 def test_count_with_labels_csv_is_what_the_single_command_answers(labelled, single, run_cli, tmp_path):
     code, out, err = run_cli("evaluate", labelled, "--task", "count", "--json", "--jobs", "2",
                              "--plot", tmp_path / "rel.png")

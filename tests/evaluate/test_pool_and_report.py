@@ -47,7 +47,7 @@ def test_decided_coverage_confusion_and_bands_from_rows():
     assert rel["ece"] == pytest.approx(0.3)
 
 
-def test_the_table_says_undetermined_with_the_reason(capsys):
+def test_the_table_marks_undetermined_answers_and_names_failures(capsys):
     from wallcli.cli._evaluate_table import print_evaluation
     from wallcli.evaluate.run import report
 
@@ -56,6 +56,6 @@ def test_the_table_says_undetermined_with_the_reason(capsys):
                  folder="d", labels="labels.csv", skipped=[], stride=64, roi=None)
     print_evaluation(res)
     out = " ".join(capsys.readouterr().out.split())
-    assert "undetermined [1]" in out and "[1] signal 3 dB under" in out
-    assert "error [2]" in out and "[2] no such file: c.mp4" in out
+    assert "b.mp4 1 0 ? " in out and "[1]" not in out  # the answer with '?', no footnote
+    assert "c.mp4 0 error" in out and "1 clip failed: no such file: c.mp4" in out
     assert "right 1 (33.3 %)" in out and "decided 1 (33 %)" in out  # right; decided (coverage)

@@ -1,4 +1,4 @@
-"""evaluate's terminal view: 80 columns with long reasons in footnotes, plurals, a late progress bar."""
+"""evaluate's terminal view: 80 columns, one line a clip under the figures, plurals, a late progress bar."""
 from __future__ import annotations
 
 import io
@@ -31,22 +31,40 @@ def _result(n: int, skipped: int) -> dict:
 
 
 def test_sixty_clips_fit_80_columns_one_line_each(monkeypatch, capsys):
+    """The figures on top (bands, then decided), then one line a clip: the answer with '?' when
+    undetermined, the truth, right or not, one SNR named in the header; no footnote per row (120
+    clips took 265 lines)."""
     from wallcli.cli._evaluate_table import print_evaluation
 
     monkeypatch.setattr(output.console_out, "width", 80)
     print_evaluation(_result(60, 1))
     lines = capsys.readouterr().out.splitlines()
     assert max(len(x) for x in lines) <= 80
-    top = lines.index(next(x for x in lines if x.startswith("─")))  # the rule under the header
-    bottom = lines.index(next(x for x in lines[top:] if x.startswith("[1] ")))  # the footnotes follow the rows
-    assert bottom - top - 1 == 60  # no row wraps
+    assert lines[:2] == ["transfer (labels: labels.csv)", "activity by wallcli-activity 0.3.1, 60 clips"]
+    order = [next(i for i, x in enumerate(lines) if x.startswith(t)) for t in ("By SNR band", "Summary", "Confusion",
+                                                                               "activity by wallcli-activity 0.3.1, per clip")]
+    assert order == sorted(order)  # bands and decided figures first, the clips last
+    head = lines[order[-1] + 1]
+    assert head.split() == ["file", "det", "truth", "answer", "p", "%", "right", "SNR", "dB"]
+    top = order[-1] + 2  # the rule under the header
+    assert lines[top].startswith("─")
+    clip_lines = lines[top + 1:top + 61]
     res = _result(60, 1)
-    assert all(r["file"] in x for r, x in zip(res["rows"], lines[top + 1:bottom]))  # whole names, not cut
-    text = "\n".join(lines)
-    assert "undetermined [1]" in text and "\n[1] p=0.001 for 'none' at -19 dB; 97% right only from p=0.994" in text
-    assert "error [" in text and "Invalid data found" in "\n".join(lines[bottom:])
-    assert lines[:2] == ["transfer (labels: labels.csv)", "activity by wallcli-activity 0.3.1, 60 clips"] and "\n1 clip skipped: more than one person" in text
-    assert len(lines) < 2 * 60 + 40  # footnotes: a line or two each, not five lines a row as before
+    for r, x in zip(res["rows"], clip_lines):  # whole names, not cut; one line each
+        cells = x.split()
+        assert cells[0] == r["file"]
+        if r["error"]:
+            assert "error" in cells
+        else:
+            shown = cells[3:5] if r["confident"] is False else cells[3:4]
+            assert shown == ([r["label"], "?"] if r["confident"] is False else [r["label"]])
+            assert ("yes" if r["correct"] else "no") in cells and cells[-1] == f"{r['snr_db']:.1f}"
+    rest = "\n".join(lines[top + 61:])
+    above = " ".join(" ".join(lines[order[-2]:order[-1]]).split())  # between the confusion and the clips
+    assert "?: undetermined" in above and "SNR dB: measured" in above  # the columns' meaning heads the table
+    assert "97% right only from" not in "\n".join(lines) and "[1]" not in "\n".join(lines)
+    assert "Invalid data found" in rest and "1 clip skipped: more than one person" in "\n".join(lines)
+    assert len(lines) <= 60 + 50  # one line a clip, plus the figures
 
 
 def test_plurals():

@@ -4,6 +4,7 @@ import numpy as np
 from wallcli.infer.confidence import NO_BLOCK_REASON, fit, judge, validate_block
 
 CLASSES = [0, 1, 2]
+NEUTRAL = ["a", "b", "c"]  # classes none of which is 'nobody' (never decided): the fit alone is tested
 
 
 def _validation(seed=0, n=6000):
@@ -33,7 +34,7 @@ def test_fitted_thresholds_meet_the_level_where_they_exist():
     assert block["thresholds"][0][0] is None  # the faint band's 'nobody' is never right: never decided
     decided = np.array([judge(block, p, s, CLASSES)[0] for p, s in zip(probs, snr)])
     right = probs.argmax(1) == truth
-    assert decided.mean() > 0.15  # (nobody under the noise is never decided: judge, NOBODY)
+    assert decided.mean() > 0.1  # (a third of the answers are 'nobody', never decided: judge, NOBODY)
     assert right[decided].mean() >= 0.95  # in-sample, the level holds by construction
     # on fresh windows from the same process it holds within sampling error
     p2, t2, s2 = _validation(seed=1)
@@ -59,7 +60,7 @@ def test_a_threshold_must_hold_in_every_validation_set_on_its_own():
     hard = groups == 1
 
     def decided(block):
-        return np.array([judge(block, p, s, CLASSES)[0] for p, s in zip(P[hard], S[hard])])
+        return np.array([judge(block, p, s, NEUTRAL)[0] for p, s in zip(P[hard], S[hard])])
 
     assert decided(pooled).sum() > 80  # pooled, the easy world vouches for the hard one's coin tosses
     assert decided(per_set).sum() < 25  # per set, only where too few of the hard world's answers remain
@@ -89,14 +90,19 @@ def test_a_malformed_block_is_named():
     assert "one entry per class" in validate_block(block, 5)
 
 
-def test_nobody_under_the_noise_is_never_decided_whatever_the_card_says():
+def test_nobody_is_never_decided_whatever_the_card_says():
     """An empty room and a person too faint to see give the same plot: 'nobody' (count 0,
-    activity 'none') said of a signal under the noise stays undetermined even where a card's
-    calibration, which left faint people out, certified it; above the noise the card decides."""
+    activity 'none') stays undetermined even where a card's calibration, which left faint people
+    out, certified it; under the noise and above it alike (codec residue reads as a few dB on an
+    empty wall). An answer that someone moves is the card's to judge."""
     block = {"level": 0.97, "signal_edges_db": [0.0], "thresholds": [[0.9, 0.9, 0.9], [0.9, 0.9, 0.9]]}
     ok, reason = judge(block, [0.99, 0.005, 0.005], -3.0, CLASSES)
     assert not ok and "no movement above the camera's noise" in reason and "-3.0 dB" in reason
-    assert judge(block, [0.99, 0.005, 0.005], 2.0, CLASSES) == (True, None)
+    ok, reason = judge(block, [0.99, 0.005, 0.005], 2.0, CLASSES)
+    assert not ok and "'0 people' is never decided" in reason and "2.0 dB" in reason
     assert judge(block, [0.005, 0.99, 0.005], -3.0, CLASSES) == (True, None)  # a person seen is the card's to judge
     acts = ["none", "walking", "crouching"]
-    assert judge(block, [0.99, 0.005, 0.005], -3.0, acts)[0] is False
+    for snr in (-3.0, 2.0, 25.0):
+        ok, reason = judge(block, [0.99, 0.005, 0.005], snr, acts)
+        assert not ok and "faint" in reason
+    assert judge(block, [0.005, 0.99, 0.005], 2.0, acts) == (True, None)

@@ -89,6 +89,7 @@ class _FakeReader:
             yield SimpleNamespace(index=i, time=i / 30.0, planes=planes)
 
 
+@pytest.mark.slow
 def test_memory_does_not_grow_with_video_length(models, monkeypatch):
     model = Model.load(models["count"])
 

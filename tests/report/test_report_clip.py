@@ -71,7 +71,7 @@ def test_evidence_identity(clip_report, hostile_clip):
     assert facts["Frame rate"].startswith("30 fps")
     assert facts["Duration"].startswith("9.000 s decoded")
     assert "h264" in facts["Codec, pixel format"] and "yuv420p" in facts["Codec, pixel format"]
-    assert "mp4" in facts["Container"]
+    assert facts["Container"] == "MP4"  # not FFmpeg's 'mov,mp4,m4a,3gp,3g2,mj2'
     assert facts["Decode warnings"] == "none"
     assert facts["Region analysed (ROI)"] == "x 0, y 0, 64 × 48 pixels"
     assert facts["Command"].startswith("wallcli report ") and "-o " in facts["Command"]
@@ -130,6 +130,36 @@ def test_models_come_from_their_cards(clip_report):
         tr = card["transfer"]
         assert f"{100 * tr['accuracy']:.1f} %" in text  # the independent renderer's figure beside
     assert "What it cannot do" in text
+    # the cards' own field names are said in words ('by_band', 'snr_source', 'errors: 0' were shown)
+    assert "by_band" not in text and "snr_source" not in text and "errors: 0" not in text
+
+
+def test_the_headline_says_each_undetermined_answer_in_plain_words():
+    """Every reason confidence.judge and the view check write is said in words on the headline,
+    with the answer most likely; a decided answer is stated with its probability and signal."""
+    from wallcli.infer.confidence import judge
+    from wallcli.report.verdicts import finding
+
+    block = {"level": 0.97, "signal_edges_db": [0.0], "thresholds": [[None, None, None], [0.9, None, 0.95]]}
+    cases = {
+        "nobody moving is never decided": ([0.99, 0.005, 0.005], 5.0),
+        "'1 person' answers were never right 97% of the time in validation at a signal like this one (4.7 dB)":
+            ([0.2, 0.7, 0.1], 4.7),
+        "its probability (0.80) is under the 0.95 from which '2 people' answers were right 97%": ([0.1, 0.1, 0.8], 3.0),
+    }
+    for words, (probs, snr) in cases.items():
+        ok, reason = judge(block, probs, snr, [0, 1, 2])
+        assert not ok
+        head = finding("count", {"label": int(max(range(3), key=probs.__getitem__)), "probabilities": probs,
+                                 "confident": False, "reason": reason, "signal_db": snr})
+        assert head.startswith("Count: undetermined, most likely ") and words in head and reason not in head, head
+    view = {"usable": False, "issues": ["camera motion"], "reason": "not a static view of the wall: camera motion at 0.6 s"}
+    head = finding("activity", {"label": "walking", "probabilities": [0, 1, 0, 0, 0], "confident": False,
+                                "reason": view["reason"], "view": view})
+    assert head.endswith("the video is not a still view of a wall (camera motion)")
+    head = finding("activity", {"label": "walking", "probabilities": [0, 0.97, 0.03, 0, 0], "confident": True,
+                                "reason": None, "signal_db": 12.34})
+    assert head == "Activity: walking (decided; probability 0.97, signal 12.3 dB)"
 
 
 def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monkeypatch):
@@ -163,7 +193,9 @@ def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monke
     count = page.by_id("count")
     assert count.find_all("p", class_="verdict")[0].text().startswith(f"Clip: undetermined ({reason})")
     assert all(w[2] == f"undetermined ({reason})" for w in table_rows(count.find_all("table", class_="windows")[0]))
-    assert f"undetermined ({reason})" in page.by_id("verdicts").text()
+    # the headline is a finding: the answer most likely, then why (a reason it has no words for, as it is)
+    assert page.by_id("verdicts").text().startswith(f"Count: undetermined, most likely 1 person (probability")
+    assert reason in page.by_id("verdicts").text()
     activity = page.by_id("activity")
     assert "decided (within the model's validated range)" in activity.text()
     assert "undetermined" not in activity.find_all("p", class_="verdict")[0].text()

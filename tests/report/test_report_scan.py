@@ -22,18 +22,32 @@ def index(tmp_path, run_cli):
 
 
 def test_one_row_per_video_with_its_answers(index):
-    rows = table_rows(parse(index).by_id("results"))
+    rows = [[cell.replace("/ ", "/") for cell in r] for r in table_rows(parse(index).by_id("results"))]
     assert [r[0] for r in rows] == ["cam1/0001.mp4", f"cam1/{HOSTILE}.mp4", "cam2/old.mp4", "cam2/broken.mp4", "(line 5)"]
     name, duration, snr, count, count_db, activity, activity_db, error = zip(*rows)
     assert duration == ("12.00", "30.50", "9.00", "", "")
     # figures as the results hold them: snr.snr_db of green, each task's signal_db; never "-0.0"
     assert snr == tuple(f"{r['snr']['snr_db'][1]:.1f}" for r in RECORDS[:3]) + ("", "") == ("3.0", "-20.0", "-99.0", "", "")
     assert count_db == ("12.5", "-30.0", "", "", "") and activity_db == ("0.0", "-28.5", "", "", "")
-    assert count == ("1 person (p 0.93)", "undetermined (signal 3 dB under the model's validated range)",
+    assert count == ("1 person (p 0.93)", "undetermined, most likely 2 people signal 3 dB under the model's validated range",
                      "0 people (p 0.80)", "", "")
     assert activity == ("walking (p 0.90)", "none (p 0.90)", "none (p 0.70)", "", "")
     assert error[:3] == ("", "", "") and error[3].startswith("cam2/broken.mp4 is not a readable video")
     assert error[4].startswith("line 5 is not JSON")
+
+
+def test_names_break_at_slashes_and_reasons_fold(index):
+    """A long path breaks after a '/', not inside a name (<wbr>); an undetermined answer shows
+    the answer most likely and keeps its reason, and a long error, behind a disclosure."""
+    body = parse(index).by_id("results").find_all("tbody")[0]
+    cells = [tr.find_all("td") for tr in body.find_all("tr")]
+    assert "cam1/<wbr>0001.mp4" in index and len(cells[0][0].find_all("wbr")) == 1
+    folded = cells[1][3].find_all("details")
+    assert len(folded) == 1 and folded[0].find_all("summary")[0].text() == "undetermined, most likely 2 people"
+    assert "validated range" in folded[0].text()
+    assert not cells[0][3].find_all("details")  # a decided answer is short: nothing to fold
+    error = cells[3][7].find_all("details")
+    assert len(error) == 1 and error[0].text().startswith(error[0].find_all("summary")[0].text()[:40])
 
 
 def test_sort_keys_are_numbers_and_blanks(index):

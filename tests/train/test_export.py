@@ -110,6 +110,7 @@ def test_train_without_torch_says_how_to_install(monkeypatch, capsys, tmp_path, 
     assert err.startswith("Error:") and "pip install torch==2.13.0 && pip install 'wallcli[train]'" in err
 
 
+@pytest.mark.slow
 def test_int8_export_ships_a_quantised_graph_with_remeasured_accuracy(make_dataset, tmp_path, capsys, cli_code):
     pytest.importorskip("onnx")
     import onnx

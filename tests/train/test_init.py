@@ -30,6 +30,7 @@ def _trained(task, seed=0):
     return net.eval()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", ["count", "activity"])
 def test_init_reproduces_an_exported_float_model(tmp_path, task):
     ref = _trained(task)

@@ -54,6 +54,7 @@ def _cfg(tmp_path, data, **kw):
     return TrainConfig(**base)
 
 
+@pytest.mark.slow
 def test_two_epochs_reduce_loss_and_checkpoint(make_dataset, tmp_path):
     data = make_dataset("count", 64)
     cfg = _cfg(tmp_path, data)
@@ -81,6 +82,7 @@ def test_anneal_keeps_the_seeds_rate_then_falls_to_the_floor(tmp_path):
     assert learning_rate(cfg, 4, 0, 10) == pytest.approx(1e-3 * ANNEAL_FLOOR + (1e-3 - 1e-3 * ANNEAL_FLOOR) / 2)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("anneal", [0, 1])
 def test_interrupted_run_resumes_exactly(make_dataset, tmp_path, anneal):
     data = make_dataset("count", 28)
@@ -111,6 +113,7 @@ def test_checkpoint_of_another_run_is_refused(make_dataset, tmp_path):
         train(_cfg(tmp_path, data, epochs=1, batch_size=8, seed=7))
 
 
+@pytest.mark.slow
 def test_checkpoints_within_an_epoch_on_a_timer(make_dataset, tmp_path):
     data = make_dataset("count", 24)
     events = []

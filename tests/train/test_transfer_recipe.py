@@ -42,6 +42,7 @@ def test_a_wide_count_dataset_serves_the_activity_net(make_dataset):
         ShardDataset(make, "activity")
 
 
+@pytest.mark.slow
 def test_lite_nets_train_balanced_and_calibrated(make_dataset, tmp_path, cli_code):
     data = _as_wide(make_dataset("count", 24))
     val = _as_wide(make_dataset("count", 96, seed=9, shards=1, name="val", visibility=True))

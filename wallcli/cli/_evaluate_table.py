@@ -1,7 +1,8 @@
 """The table view of ``wallcli evaluate``: per-clip rows, then the figures (all via output.py).
 
-Every table fits 80 columns: what is long (the reason an answer is undetermined, a clip's error)
-goes to numbered footnotes under the per-clip table, and the JSON has all of it.
+Every table fits 80 columns: the figures on top (bands, decided, confusion), then one line a clip
+(the answer, '?' when undetermined, the truth, right or not, the SNR); what is long (why an
+answer is undetermined) is in the JSON only.
 """
 from __future__ import annotations
 
@@ -25,51 +26,45 @@ def _of(k: int, n: int, digits: int = 0) -> str:
     return f"{k} ({_pct(k / n, digits)})" if n else "-"
 
 
-def _snr(r: dict) -> str:
-    # whole dB: the estimate is good to a few dB at best (lossy clips read high), and 80 columns have no room
-    return "-" if r["snr_db"] is None else str(round(r["snr_db"]))
+def _snr(r: dict, labels: bool) -> str:
+    # the SNR the bands are on: labels.csv's where it has the column, else the measured one
+    from wallcli.wording import format_db
 
-
-class _Notes:
-    """Numbered footnotes, one per distinct text: 40 clips undetermined for one reason take one line."""
-
-    def __init__(self) -> None:
-        self.texts: list[str] = []
-
-    def mark(self, text: str) -> str:
-        if text not in self.texts:
-            self.texts.append(text)
-        return f"[{self.texts.index(text) + 1}]"
-
-    def lines(self) -> list[str]:
-        return [f"[{i}] {t}" for i, t in enumerate(self.texts, start=1)]
+    value = r.get("snr_db_labels", r["snr_db"]) if labels else r["snr_db"]
+    return "-" if value is None else format_db(value)
 
 
 def _clips(res: dict, show_det: bool) -> None:
-    notes = _Notes()
-    cols = ["file", "truth", "answer", "p %", "SNR", "ok"]
+    """One line a clip: the answer ('?' after it when undetermined: most likely that), the truth,
+    right or not, and the SNR its band is on. Reasons and errors are in the JSON, not here: a
+    footnote a row made 265 lines of 120 clips."""
+    labels = res["snr_source"] == "labels"
+    cols = ["file", "truth", "answer", "p %", "right", "SNR dB"]
     if show_det:
         cols.insert(1, "det")
     rows = []
     for r in res["rows"]:
         if r["error"] is not None:
-            answer = "error " + notes.mark(r["error"])
-        elif r["confident"] is False:
-            answer = "undetermined " + notes.mark(r.get("reason") or "no reason given")
+            answer = "error"
         else:
-            answer = str(r["label"])
+            answer = str(r["label"]) + ("" if r["confident"] is not False else " ?")
         p = "-" if not r["probabilities"] else f"{100 * max(r['probabilities']):.0f}"
-        row = [r["file"], str(r["truth"]), answer, p, _snr(r), "yes" if r["correct"] else "no"]
+        row = [r["file"], str(r["truth"]), answer, p, "yes" if r["correct"] else "no", _snr(r, labels)]
         if show_det:
             row.insert(1, {True: "yes", False: "no", None: "?"}[r["detectable"]])
         rows.append(row)
     m = res["model"]
-    # the folder on a line of its own, which may wrap: the title line never does (it is grepped)
-    print_lines([f"{res['dir']} (labels: {res['labels']})"])
-    print_table(f"{res['task']} by {m['name']} {m['version']}, {plural(res['clips'], 'clip')}", cols, rows,
-                pad_edge=False)
-    print_lines(notes.lines(), hang=len(f"[{len(notes.texts)}] "))
-    print_lines(["p %: probability of the label; SNR: measured, dB" + ("; det: labelled detectable" if show_det else "")])
+    what = ("labels.csv snr_db (the bands' SNR)" if labels else
+            "measured block SNR of the green channel over one plot bin's area (the bands' SNR)")
+    # what the columns mean above them, the title last: it is one unwrapped line right over its table
+    print_lines(["?: undetermined, the most likely answer shown (why: --json, rows[].reason); "
+                 f"p %: its probability; SNR dB: {what}" + ("; det: labelled detectable" if show_det else "")])
+    print_table(f"{res['task']} by {m['name']} {m['version']}, per clip", cols, rows, pad_edge=False)
+    failed: dict[str, int] = {}
+    for r in res["rows"]:
+        if r["error"] is not None:
+            failed[r["error"]] = failed.get(r["error"], 0) + 1
+    print_lines([f"{plural(n, 'clip')} failed: {why}" for why, n in failed.items()], hang=2)
 
 
 def _confusion(res: dict) -> None:
@@ -119,9 +114,13 @@ def _summary(res: dict, show_det: bool) -> None:
 
 
 def print_evaluation(res: dict) -> None:
-    # a detectable column only where it tells the rows apart
+    # the figures first (bands, then decided and right), the clips under them, one line each
     show_det = any(r["detectable"] is False for r in res["rows"])
-    _clips(res, show_det)
-    _confusion(res)
+    m = res["model"]
+    # the folder on a line of its own, which may wrap: the title line never does (it is grepped)
+    print_lines([f"{res['dir']} (labels: {res['labels']})"])
+    print_lines([f"{res['task']} by {m['name']} {m['version']}, {plural(res['clips'], 'clip')}"])
     _bands(res)
     _summary(res, show_det)
+    _confusion(res)
+    _clips(res, show_det)

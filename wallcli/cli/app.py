@@ -23,10 +23,10 @@ mean, averages the wall over many pixels (noise falls as 1/sqrt(pixels)), and re
 resulting space-time plots.
 
 \b
-Pipeline:  wallcli snr clip.mp4 --roi auto        # is there any signal, and where?
+Pipeline:  wallcli snr clip.mp4 --roi auto        # any signal, and where?
            wallcli stplot clip.mp4 -o p.npz --png p.png
            wallcli count p.npz --json              # 0, 1 or 2 people
-           wallcli activity clip.mp4               # none/walking/crouching/waving/jumping
+           wallcli activity clip.mp4               # what they are doing
            wallcli amplify clip.mp4 amp.mp4        # see the invisible signal
            wallcli report clip.mp4 -o report.html  # one page to hand over
 

@@ -43,12 +43,13 @@ def evaluate(
 
     Each clip is decoded once, classified exactly as 'wallcli count' / 'activity' would
     (same model, windows and stride) and its SNR measured (green channel, wallcli snr's
-    estimator at the block size of one space-time plot bin). Prints one row per clip
-    (long reasons as footnotes), the confusion matrix with accuracy per class, clips right
+    estimator at the block size of one space-time plot bin). Prints first the clips right
     by SNR band (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db
     column where there is one, else on the measured SNR), accuracy with a 95 % bootstrap
-    interval over clips, and how many answers were decided (not 'undetermined') and how
-    often those were right. With a 'detectable' column, the headline figures are on
+    interval over clips, how many answers were decided (not 'undetermined') and how often
+    those were right, and the confusion matrix with accuracy per class; then one line per
+    clip: the answer ('?' after it when undetermined; why: --json), the truth, right or
+    not, and the SNR its band is on. With a 'detectable' column, the headline figures are on
     detectable clips and the same on all clips follow; the bands count every clip. For
     activity, clips with more than one person are skipped; so is a clip whose sidecar is
     damaged, with a warning. A clip that cannot be analysed (missing, corrupt, too short)
@@ -64,7 +65,8 @@ def evaluate(
     Examples:
       wallcli evaluate recordings/ --task count
       wallcli evaluate recordings/ --task activity --json | jq '.accuracy, .ci95'
-      wallcli evaluate recordings/ --task count --model new.onnx --plot reliability.png --jobs 4
+      wallcli evaluate recordings/ --task count --model new.onnx --jobs 4
+      wallcli evaluate recordings/ --task count --plot reliability.png
       wallcli evaluate recordings/ --task count --min-snr 0 --json | jq '.by_band'
     """
     from wallcli.errors import UsageError

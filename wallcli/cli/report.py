@@ -49,7 +49,8 @@ def report(
     Examples:
       wallcli report clip.mp4 -o clip.html
       wallcli report clip.mp4 --roi 100,50,640,360 -o clip.html --force
-      wallcli scan cam1/*.mp4 -o results.jsonl && wallcli report results.jsonl -o index.html
+      wallcli scan cam1/*.mp4 -o results.jsonl
+      wallcli report results.jsonl -o index.html
     """
     from wallcli.errors import UsageError
 

@@ -118,10 +118,11 @@ def simulate(
 
     \b
     Examples:
-      wallcli simulate -o walk.mp4 --people 1 --activity walking --seed 3 --preview walk.png
-      wallcli simulate -o two.mkv --people 2 --activity walking,jumping --size 160x120
+      wallcli simulate -o walk.mp4 --people 1 --activity walking --seed 3
+      wallcli simulate -o empty.mp4 --people 0 --preview empty.png
+      wallcli simulate -o two.mkv --people 2 --activity walking,jumping
       wallcli simulate --dataset 20000 --task count -o data/count --jobs 2
-      wallcli simulate --dataset 2000 --task activity --domain shifted -o data/val_act
+      wallcli simulate --dataset 2000 --task activity --domain shifted -o val
     """
     from wallcli.errors import UsageError
 

@@ -34,6 +34,7 @@ PREDICT_PARAMS = {
     "frames": ("--frames", 1.0, "Camera model: frames averaged.", dict(lo=1, hi=1e9)),
 }
 MAX_SWEEP = 10000
+AUTO_MIN_PX = 64  # --roi auto's smallest side: the space-time plots' 64 bins, one pixel each
 
 
 def _predict_option(name: str):
@@ -47,12 +48,13 @@ def snr(
                                       "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
                                       "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
                                       "covariances), leaving out cells where the view check saw a moving object, clipping or black. "
-                                      "'auto' reads the file twice. Default: whole frame."),
+                                      f"'auto' reads the file twice and is at least {AUTO_MIN_PX} px on each side (the "
+                                      "frame's side if smaller), so the plots' 64 bins hold a pixel each. Default: whole frame."),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object (docs/contract.md fields, plus extras) on stdout."),
     heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
-                                        "with --predict --sweep, SNR (or signal power) against the swept parameter."),
+                                        "with --predict --sweep, SNR against the swept parameter (signal power without --mean-code and --gain)."),
     max_pixels: int = number_option(32768, "--max-pixels", lo=0, hi=2**31, integer=True, help="Pixels measured per frame: a larger ROI is sampled by a regular "
                                    "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
                                    "decode speed). 0 = every pixel of the ROI (exact, slower)."),
@@ -124,7 +126,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     import warnings
 
     from wallcli.cli.common import parse_roi
-    from wallcli.cli.output import emit_json, print_table, progress, warn, wrote
+    from wallcli.cli.output import emit_json, print_lines, print_table, progress, warn, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
@@ -152,12 +154,15 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
                     whole(frame)
                     advance()
         avoid = whole.avoid(grid.grid_roi, grid.rows, grid.cols)
+        # a sliver makes fractional, overlapping bins of the same few pixels (a 10 px strip of
+        # walking.mp4 turned count's 1 into 2): at least one pixel per bin, or the whole frame's side
+        smallest = (-(-AUTO_MIN_PX // grid.ch), -(-AUTO_MIN_PX // grid.cw))
         try:
-            roi_t, auto_snr = grid.best_roi(avoid)
+            roi_t, auto_snr = grid.best_roi(avoid, min_cells=smallest)
         except ValueError:
             notes.append("--roi auto: the view failed somewhere in every part of the frame (a mover "
                          "or clipping); the ROI was chosen as if it had not")
-            roi_t, auto_snr = grid.best_roi()
+            roi_t, auto_snr = grid.best_roi(min_cells=smallest)
             avoid[:] = False
         if avoid.any():
             notes.append(f"--roi auto left out {int(avoid.sum())} of {avoid.size} cells where the view check saw "
@@ -188,6 +193,9 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         refuse_view(input, result["view"])
     res = acc.result()
     notes = result["warnings"]
+    from wallcli.signal.snr_verdict import snr_verdict
+
+    result["verdict"] = snr_verdict(result)
     if auto:
         result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
                           "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0)),
@@ -211,6 +219,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         warn(n)
     if not result["view"]["usable"]:  # the figures below then measure more than a wall's light
         warn(result["view"]["reason"])
+    print_lines([f"Verdict: {result['verdict']['text']}."])
     how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
@@ -219,6 +228,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         [[f"{s['block']}x{s['block']}", _triple(s["signal_power"]), _triple(s["noise_power"]),
           _triple(s["snr_db"], format_db, 5)] for s in result["scales"]],
     )
+    print_lines([f"Why the verdict: {result['verdict']['why']}."])
 
 
 def _triple(v, fmt=None, width: int = 7) -> str:
@@ -304,10 +314,10 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
     if plot is not None:
         from wallcli.plots.snr import save_sweep_png
 
-        save_sweep_png(plot, key, rows, force=force)
+        what = save_sweep_png(plot, key, rows, force=force)
         from wallcli.cli.output import wrote
 
-        wrote((plot, f"predicted SNR against {key.replace('_', '-')}"))
+        wrote((plot, f"predicted {what} against {key.replace('_', '-')}"))
     if json_out:
         emit_json({"mode": "predict", "parameters": settings, "sweep": {"parameter": key.replace("_", "-"), "values": values},
                    "rows": rows})

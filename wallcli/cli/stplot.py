@@ -37,8 +37,8 @@ def stplot(
     \b
     Examples:
       wallcli stplot clip.mp4 -o plots.npz --png plots.png
-      wallcli stplot clip.mp4 --roi 100,50,640,360 --png wall.png --style diverging
-      ffmpeg -i rtsp://cam/stream -f nut - | wallcli stplot - --mean ema -o live.npz
+      wallcli stplot clip.mp4 --roi 100,50,640,360 --png w.png --style diverging
+      ffmpeg -i rtsp://cam/s -f nut - | wallcli stplot - --mean ema -o live.npz
     """
     from wallcli.errors import UsageError
 
@@ -61,12 +61,30 @@ def stplot(
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
             plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)
+    narrow = narrow_roi(plot.meta["roi"], plot.bins)
+    if narrow:
+        from wallcli.cli.output import warn
+
+        plot.meta.setdefault("warnings", []).append(narrow)
+        warn(narrow)
     with committed_together():  # the .npz, the PNG and the JSON: all or none
         _write(plot, input, output, png, style, gain, json_out, force)
     from wallcli.cli.output import wrote
 
     shape = f"{plot.bins} positions x {plot.frames} frames"
     wrote((output, f"horizontal and vertical space-time plots, {shape}"), (png, "both plots, amplified"))
+
+
+def narrow_roi(roi, bins: int) -> str | None:
+    """A warning when the ROI has fewer pixels on a side than the plots have bins: the bins then
+    interpolate between the same few pixels, and the plot holds no more independent positions
+    than pixels (a 10 px strip gives 64 bins of 10 pixels' worth)."""
+    _, _, w, h = roi
+    if min(w, h) >= bins:
+        return None
+    side = f"{w} px wide" if w <= h else f"{h} px high"
+    return (f"the ROI ({w}x{h} px) is {side}, fewer pixels than its {bins} bins: neighbouring bins share "
+            f"pixels, so the plots hold at most {min(w, h)} independent positions (use a larger ROI or --bins)")
 
 
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:

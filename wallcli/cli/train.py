@@ -90,8 +90,8 @@ def train(
     \b
     Examples:
       wallcli simulate --dataset 20000 --task count -o data/count --jobs 2
-      wallcli simulate --dataset 2000 --task count --domain shifted --seed 7 -o data/val_count
-      wallcli train count --data data/count --val data/val_count --out models/count.onnx
+      wallcli simulate --dataset 2000 --task count --domain shifted -o data/val
+      wallcli train count --data data/count --val data/val --out count.onnx
     """
     try:
         import torch  # noqa: F401

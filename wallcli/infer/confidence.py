@@ -25,11 +25,14 @@ from wallcli.wording import format_db, label_text
 FORMAT = "wallcli.confidence v1"
 MIN_SUPPORT = 25  # validation windows a threshold must rest on
 NO_BLOCK_REASON = "the model card states no validated confidence thresholds"
-# "Nobody moves" said of a wall whose signal is under its noise is never decided: an empty room
-# and a person too faint to see (farther away, dimmer light, smaller motion) give the same plot,
-# and no validation set can say how often a user's rooms hold the second. The simulated
-# calibration left out people under -20 dB, which made such answers look 97 % right; on the
-# transfer set count decided "nobody" on 4 clips whose person was under the noise, all wrong.
+# "Nobody moves" (count's 0, activity's 'none') is never decided, by any task, at any signal: an
+# empty room and a person too faint to see (farther away, dimmer light, smaller motion) give the
+# same plot, and no validation set can say how often a user's rooms hold the second. The
+# simulated calibration left out people under -20 dB, which made such answers look 97 % right;
+# on the transfer set count decided "nobody" on 4 clips whose person was under the noise, all
+# wrong. A measured signal above the plot's noise does not rescue it: codec residue and light
+# changes read as a few dB on an empty wall (examples/empty.mp4: 3 dB), where activity's card
+# certified 'none' and count's did not, so the two commands disagreed on the same clip.
 NOBODY = (0, "none")
 NOISE_FLOOR_DB = 0.0
 
@@ -124,9 +127,11 @@ def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]
     label = classes[k]
     what = label_text(label)
     # 'signal' names the figure: the window's signal_db, not the per-pixel SNR of `wallcli snr`
-    if label in NOBODY and snr_db < NOISE_FLOOR_DB:
-        return False, (f"no movement above the camera's noise (signal {format_db(snr_db)} dB): "
-                       "a fainter person would not show")
+    if label in NOBODY:
+        seen = ("no movement above the camera's noise" if snr_db < NOISE_FLOOR_DB
+                else f"'{what}' is never decided")
+        return False, (f"{seen} (signal {format_db(snr_db)} dB): an empty room and a person too "
+                       "faint to show give the same plot")
     if t is None:
         return False, (f"'{what}' at signal {format_db(snr_db)} dB: never {level:.0%} right in validation "
                        f"({_band_text(edges, b)})")

@@ -179,6 +179,11 @@ def frame_planes(frame) -> Planes:
     return Planes(y, u, v, kind="yuv", sub_x=sx, sub_y=sy, depth=bits, matrix=spc, full_range=full)
 
 
+STDIN_MP4 = ("-: an MP4 cannot be streamed on stdin (its index is at the end of the file, where a pipe "
+             "cannot seek); give its path, or stream MPEG-TS, Matroska, NUT or Y4M "
+             "(ffmpeg -i clip.mp4 -c copy -f mpegts -)")
+
+
 def _describe_open_error(source: str, exc: Exception) -> WallcliError:
     text = str(exc)
     if isinstance(exc, FileNotFoundError) or "No such file" in text:
@@ -325,6 +330,8 @@ class VideoReader:
                     yield Frame(index, t, frame_planes(frame), frame)
                     index += 1
                 elif kind == "damage":
+                    if index == 0 and self._mp4_on_a_pipe():
+                        raise WallcliError(STDIN_MP4)
                     self._warn(f"{self.source}: the stream is damaged after frame {index} ({item}); "
                                "using the frames before the damage")
                 elif kind == "error":
@@ -338,6 +345,12 @@ class VideoReader:
             self._stop_worker()
         if index == 0:
             raise WallcliError(f"{self.source}: no frames could be decoded")
+
+    def _mp4_on_a_pipe(self) -> bool:
+        """An MP4 (or MOV) read from stdin: its index usually sits at the end of the file, where a
+        pipe cannot seek, so FFmpeg reports damage at the first frame (one written with
+        '-movflags +faststart' streams)."""
+        return self.source == "-" and "mp4" in self.info.container.split(",")
 
     def _check_complete(self, decoded: int, last_time: float) -> None:
         """Warn when the file promised more frames or more time than it held (truncation)."""

@@ -73,22 +73,38 @@ def save_scales_png(path, result: dict, *, force: bool = False) -> None:
     save_figure(fig, path, force=force)
 
 
-def save_sweep_png(path, key: str, rows: list[dict], *, force: bool = False) -> None:
-    """Predicted SNR (or signal power without a camera model) against the swept parameter."""
+# units of the swept parameters, for the x axis (the rest are ratios or counts)
+UNITS = {"distance": "m", "radius": "m", "area": "m$^2$", "person_radiance": "code values",
+         "background_radiance": "code values", "contrast": "code values", "mean_code": "code value",
+         "gain": "electrons per code value", "read_noise": "electrons RMS", "bits": "bits"}
+
+
+def sweep_quantity(rows: list[dict]) -> str:
+    """What a sweep's figure plots: SNR where a camera model gave noise, else signal power."""
+    return "SNR" if "snr" in rows[0] else "signal power"
+
+
+def save_sweep_png(path, key: str, rows: list[dict], *, force: bool = False) -> str:
+    """Predicted SNR (or signal power without a camera model) against the swept parameter; returns
+    what it plotted ('SNR' or 'signal power'), which the caller names, so the two never differ."""
     fig, ax = new_figure(figsize=(7, 4.5), constrained_layout=True)
     x = np.array([r[key] for r in rows], np.float64)
-    if "snr" in rows[0]:
+    what = sweep_quantity(rows)
+    if what == "SNR":
         y, label = np.array([r["snr"] for r in rows]), "predicted SNR (signal / noise power)"
     else:
         y, label = np.array([r["signal_power"] for r in rows]), "predicted signal power (code values$^2$)"
     ax.plot(x, y, "o-")
     if np.all(y > 0):
         ax.set_yscale("log")
-        if "snr" in rows[0] and y.min() < 1 < y.max():
+        if what == "SNR" and y.min() < 1 < y.max():
             ax.axhline(1.0, color="0.5", ls="--", lw=1, label="SNR = 1 (0 dB)")
             ax.legend(fontsize=8)
-    ax.set_xlabel(key.replace("_", " "))
+    name = key.replace("_", " ")
+    ax.set_xlabel(f"{name} ({UNITS[key]})" if key in UNITS else name)
     ax.set_ylabel(label)
     ax.grid(True, which="both", alpha=0.3)
-    ax.set_title(f"wallcli snr --predict: sweep of {key.replace('_', ' ')}", fontsize=10, loc="left")
+    note = "" if what == "SNR" else " (no camera model: --mean-code and --gain give SNR)"
+    ax.set_title(f"wallcli snr --predict: {what} against {name}{note}", fontsize=10, loc="left")
     save_figure(fig, path, force=force)
+    return what

@@ -43,7 +43,7 @@ def save_stplot_png(path, plot, *, style: str = "rgb", gain: float | None = None
     g, image = draw_stplot(axes, plot, style=style, gain=gain)
     src = plot.meta.get("source", "")
     axes[0].set_title(f"{src}: space-time plots, mean removed, x{g:.3g} "
-                      f"(full scale = +-{0.5 / g:.3g} code values)", fontsize=10, loc="left")
+                      f"(full scale \u00b1{0.5 / g:.2g} code values)", fontsize=10, loc="left")
     if image is not None:
         fig.colorbar(image, ax=list(axes), label="luminance change (code values)", shrink=0.8)
     save_figure(fig, path, force=force)

@@ -64,6 +64,23 @@ _TRANSFER_KNOWN = ("dir", "dataset", "set", "description", "accuracy", "ci95", "
                    "accuracy_decided", "decided", "command", "note")
 
 
+# a card's own field names, as a page says them: (label, {value: words})
+_OTHER_WORDS = {
+    "errors": ("clips that failed", {}),
+    "snr_source": ("clips put in SNR bands by", {"labels": "the SNR their labels give",
+                                                 "measured": "the SNR wallcli measured"}),
+    "source": ("clips made by", {}),
+}
+_FIELD_WORDS = {"by_band": "the SNR bands", "snr_source": "the SNR source"}
+
+
+def _no_field_names(text: str) -> str:
+    """A card's description with the JSON field names it cites said in words."""
+    for field, words in _FIELD_WORDS.items():
+        text = text.replace(field, words)
+    return text
+
+
 def _transfer(block: Any) -> list[dict[str, Any]] | None:
     """The card's "transfer" figures (accuracy on an independent renderer's clips), one or a list."""
     if block is None:
@@ -72,10 +89,20 @@ def _transfer(block: Any) -> list[dict[str, Any]] | None:
     for b in block if isinstance(block, list) else [block]:
         if not isinstance(b, dict):
             continue
-        # figures this page does not know by name are still shown, as they are written
-        other = {str(k): v for k, v in b.items() if k not in _TRANSFER_KNOWN and isinstance(v, (str, int, float, bool))}
+        # figures this page does not know by name are still shown, named in words
+        other = {}
+        for k, v in b.items():
+            if k in _TRANSFER_KNOWN or not isinstance(v, (str, int, float, bool)):
+                continue
+            if k == "errors" and v == 0:  # 'errors: 0' says nothing a reader needs
+                continue
+            words = _OTHER_WORDS.get(k)
+            if words is None:
+                other[str(k).replace("_", " ")] = v
+            else:
+                other[words[0]] = words[1].get(v, v) if isinstance(v, str) else v
         out.append({
-            "set": set_name(b, "transfer set"),
+            "set": _no_field_names(set_name(b, "transfer set")),
             "accuracy": _num(b.get("accuracy")), "ci": _ci(b.get("ci95") or b.get("accuracy_95ci")),
             "clips": b.get("scored") if b.get("scored") is not None else b.get("clips"),
             "coverage": _num(b.get("coverage")), "accuracy_decided": _num(b.get("accuracy_decided")),

@@ -5,7 +5,7 @@ from datetime import datetime, timezone
 from typing import Any
 
 from wallcli.report.render import render
-from wallcli.report.verdicts import answer
+from wallcli.report.verdicts import answer, container_name, finding
 
 CHANNELS = ("R", "G", "B")
 
@@ -19,7 +19,8 @@ def _snr_rows(snr) -> list[dict[str, Any]]:
 def _task_view(task: str, result: dict | None, failure: str | None, figure: str | None) -> dict[str, Any]:
     if result is None:
         return {"task": task, "result": None, "failure": failure or "no result", "figure": None, "windows": [],
-                "classes": [], "clip": answer(task, None), "model": None}
+                "classes": [], "clip": answer(task, None), "model": None,
+                "finding": f"{task.capitalize()}: no answer ({failure or 'no result'})"}
     classes = [str(c) for c in result.get("classes", [])]
     windows = []
     for w in result.get("windows", []):
@@ -27,7 +28,7 @@ def _task_view(task: str, result: dict | None, failure: str | None, figure: str 
                         "signal_db": w.get("signal_db"), "probabilities": list(w.get("probabilities") or [])})
     return {"task": task, "result": result, "failure": None, "figure": figure, "windows": windows,
             "classes": classes, "clip": answer(task, result), "probabilities": list(result.get("probabilities") or []),
-            "undetermined": sum(not w["answer"]["decided"] for w in windows)}
+            "undetermined": sum(not w["answer"]["decided"] for w in windows), "finding": finding(task, result)}
 
 
 def clip_page(a, *, command: str) -> str:
@@ -40,7 +41,8 @@ def clip_page(a, *, command: str) -> str:
              for t in ("count", "activity")]
     return render(
         "clip.html.j2",
-        title=a.identity["path"], identity=a.identity, command=command, roi=list(a.roi),
+        title=a.identity["path"], command=command, roi=list(a.roi),
+        identity=dict(a.identity, container=container_name(a.identity.get("container"), a.identity.get("path"))),
         snr={"rows": _snr_rows(a.snr), "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
              "pixels": a.snr.sampled_pixels, "channels": CHANNELS},
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},

@@ -20,7 +20,7 @@ def environment():
 
     env = Environment(loader=PackageLoader("wallcli.report", "templates"), autoescape=True,
                       undefined=StrictUndefined, trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
-    env.filters.update(pct=pct, num=num, ci=ci, nbytes=nbytes, hms=hms, db=db)
+    env.filters.update(pct=pct, num=num, ci=ci, nbytes=nbytes, hms=hms, db=db, path_breaks=path_breaks)
     return env
 
 
@@ -55,6 +55,14 @@ def render(template: str, *, scripts: tuple[str, ...] = (), **context) -> str:
     # JSON: the page is UTF-8 and cannot hold its raw bytes
     return escape_surrogates(environment().get_template(template).render(
         csp=csp([style], code), style=Markup(style), scripts=[Markup(c) for c in code], **context))
+
+
+def path_breaks(name) -> Markup:
+    """A file name, escaped, that a narrow column breaks after each '/' (a break opportunity,
+    <wbr>) rather than anywhere inside a folder's or file's name."""
+    from markupsafe import escape
+
+    return Markup("/<wbr>").join(escape(part) for part in str(name).split("/"))
 
 
 # ---------------------------------------------------------------------------- number filters

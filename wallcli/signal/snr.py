@@ -552,11 +552,12 @@ class GridAccumulator:
         sig, noi = powers_from_sums(self.s1, self.s2, self.sd, dsum, self.frames, 1.0, ())
         return sig, noi, self.lum / self.frames
 
-    def best_roi(self, avoid: np.ndarray | None = None) -> tuple[Roi, float]:
+    def best_roi(self, avoid: np.ndarray | None = None, min_cells: tuple[int, int] = (1, 1)) -> tuple[Roi, float]:
         """The rectangle of whole cells whose spatially averaged grey level has the highest SNR,
         among those with no cell marked in ``avoid`` ((rows, cols) bool: where the view check
-        saw the view fail; a mover in view would otherwise be the 'signal' chosen). Raises
-        ValueError when every rectangle holds a marked cell.
+        saw the view fail; a mover in view would otherwise be the 'signal' chosen), at least
+        ``min_cells`` (rows, cols) of cells in size. Raises ValueError when every rectangle holds a
+        marked cell.
 
         Var of a rectangle's mean = (sum of the cells' covariances over the rectangle) / n^2, for
         signal and for frame differences alike; 4-D prefix sums give every rectangle at once.
@@ -569,7 +570,8 @@ class GridAccumulator:
         r, c = self.rows, self.cols
         y0, y1, x0, x1 = (a.ravel() for a in np.meshgrid(np.arange(r + 1), np.arange(r + 1),
                                                         np.arange(c + 1), np.arange(c + 1), indexing="ij"))
-        keep = (y1 > y0) & (x1 > x0)
+        min_r, min_c = min(int(min_cells[0]), r), min(int(min_cells[1]), c)
+        keep = (y1 - y0 >= max(min_r, 1)) & (x1 - x0 >= max(min_c, 1))
         y0, y1, x0, x1 = y0[keep], y1[keep], x0[keep], x1[keep]
         if avoid is not None and avoid.any():
             p = np.zeros((r + 1, c + 1))

@@ -20,6 +20,8 @@ from collections import deque
 
 import numpy as np
 
+from wallcli.wording import span_text
+
 MAX_SIDE = 320  # registration scale: finer texture than this is not needed to see a pan
 BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
 K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) from its slow background
@@ -549,5 +551,5 @@ class ViewCheck:
 
 
 def _spans_text(spans: list) -> str:
-    shown = ", ".join(f"{a:.1f}-{b:.1f} s" if b > a else f"{a:.1f} s" for a, b in spans[:3])
+    shown = ", ".join(span_text(a, b) for a, b in spans[:3])
     return shown + (f" and {len(spans) - 3} more" if len(spans) > 3 else "")

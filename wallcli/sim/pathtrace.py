@@ -114,7 +114,7 @@ def _probe(v: str) -> str | None:
 
     env = dict(os.environ, WALLCLI_PT_VARIANT=v)
     try:
-        r = subprocess.run([sys.executable, "-c", "from wallcli.sim.pathtrace import _selftest; _selftest()"],
+        r = subprocess.run([sys.executable, "-m", "wallcli.sim.pt_selftest"],
                            env=env, capture_output=True, text=True, timeout=300)
     except subprocess.TimeoutExpired:
         return "the test render took over 300 s"
@@ -122,18 +122,6 @@ def _probe(v: str) -> str | None:
         return None
     lines = [ln for ln in (r.stderr or r.stdout).splitlines() if ln.strip()]
     return (lines[0][:160] if lines else f"exit {r.returncode}")
-
-
-def _selftest() -> None:
-    """Render a 4 x 4 wall with one person in a small room, twice (the variant probe's child)."""
-    from wallcli.sim.scene import SceneConfig, sample_scene
-
-    sc = sample_scene(0, SceneConfig(people=1, activities=["walking"], duration=0.1, fps=20, grid=(4, 4)))
-    tr = PathTracer(sc.room, sc.points, sc.people, sc.poses, spp=2)
-    E = tr.irradiance(0)
-    assert np.isfinite(E).all() and E.shape == (4, 4, 3)
-    tr.irradiance(1)
-    print("ok")
 
 
 def _frame(s: int, size, u0=0.0, u1=1.0, v0=0.0, v1=1.0, inset: float = 0.0) -> list:

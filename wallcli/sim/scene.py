@@ -97,7 +97,9 @@ class Scene:
     def frames(self) -> Iterator[np.ndarray]:
         """uint8 RGB frames (H, W, 3)."""
         if self.config.world == "pt":
-            yield from self._pt_frames()
+            from wallcli.sim import world_pt  # the path-traced world renders this scene
+
+            yield from world_pt.frames(self)
             return
         E0 = self.static_irradiance()
         wall_albedo = np.clip(self.room.albedo[2].mean(axis=(0, 1)), 0.05, 0.95)
@@ -140,29 +142,6 @@ class Scene:
         if self.config.shadows:
             dE = dE + self.shadow_gain * shadow_delta(self.room, self.points, C, R, A)
         return dE
-
-    def _pt_frames(self) -> Iterator[np.ndarray]:
-        """frames() by path tracing: the empty room once (same sampler seed as every frame, so
-        the static room cancels exactly in the differences), then each frame's change from it."""
-        from wallcli.sim.pathtrace import PathTracer
-
-        tracer = PathTracer(self.room, self.points, self.people, self.poses, spp=self.config.spp,
-                            seed=self.seed % 2**31)
-        E0 = tracer.irradiance(None)
-        wall_albedo = np.clip(self.room.albedo[2].mean(axis=(0, 1)), 0.05, 0.95)
-        cam = Camera(self.camera, E0, wall_albedo, len(self.times), self.rng)
-        E0_safe = np.maximum(E0, 1e-12)
-        for i in range(len(self.times)):
-            dE = tracer.irradiance(i) - E0 if self.people else np.zeros_like(E0)
-            if self.clean_profiles is not None:
-                rel = dE / E0_safe
-                entry = (rel.mean(axis=0), rel.mean(axis=1))
-                if len(self.people) > 1:
-                    # each person alone: one more render per person (see the analytic path above)
-                    entry = (*entry, [((tracer.irradiance(i, who=[j]) - E0) / E0_safe).mean(axis=0)
-                                      for j in range(len(self.people))])
-                self.clean_profiles.append(entry)
-            yield cam.render(dE, i, static_E=E0)
 
     def truth(self, frames: int | None = None) -> dict:
         """The JSON sidecar: docs/contract.md fields plus everything needed to reproduce or study the clip."""

@@ -1,0 +1,81 @@
+"""The house has no circles: no two modules of wallcli import each other, directly or round a
+loop, counting imports inside functions too (sim/pathtrace.py and sim/scene.py once did: a scene
+describes, a world renders it)."""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "wallcli"
+
+
+def _imports() -> dict[str, set[str]]:
+    """{module: the wallcli modules it imports anywhere in its file}."""
+    files = {}
+    for p in PACKAGE.rglob("*.py"):
+        parts = p.relative_to(PACKAGE.parent).with_suffix("").parts
+        files[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = p
+    edges: dict[str, set[str]] = {m: set() for m in files}
+    for m, p in files.items():
+        package = m if p.name == "__init__.py" else m.rpartition(".")[0]
+        for node in ast.walk(ast.parse(p.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    up = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    base = ".".join(up + ([base] if base else []))
+                names = [base] + [f"{base}.{a.name}" for a in node.names]
+            else:
+                continue
+            for name in names:
+                while name and name not in files:
+                    name = name.rpartition(".")[0]
+                if name and name != m and not m.startswith(name + "."):  # a package's own __init__ is no loop
+                    edges[m].add(name)
+    return edges
+
+
+def _loops(edges: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected groups of more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    loops: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in edges[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                loops.append(sorted(group))
+
+    for v in edges:
+        if v not in index:
+            visit(v)
+    return loops
+
+
+def test_no_module_imports_itself_round_a_loop():
+    edges = _imports()
+    assert "wallcli.sim.pathtrace" in edges and edges["wallcli.cli.app"]  # the walk sees the package
+    assert _loops(edges) == []
+
+
+def test_the_scene_does_not_know_the_path_tracer():
+    edges = _imports()
+    assert "wallcli.sim.pathtrace" not in edges["wallcli.sim.scene"]
+    assert "wallcli.sim.scene" not in edges["wallcli.sim.pathtrace"]
