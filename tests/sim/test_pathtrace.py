@@ -142,13 +142,18 @@ def test_simulate_world_pt_writes_a_decodable_video_and_sidecar(tmp_path, run_cl
     assert frames.shape == (10, 24, 32, 3) and 5 < frames.mean() < 250
 
 
-def test_pt_dataset_records_its_world(tmp_path):
+def test_pt_dataset_records_its_world(tmp_path, monkeypatch):
     from wallcli.datagen.dataset import build_dataset
     from wallcli.io.arrays import load_npz
 
-    m = build_dataset(tmp_path / "d", 1, "count", seed=1, jobs=1, world="pt", windows_per_scene=1, shard_scenes=1,
-                      grid=(4, 6), spp=2, camera_overrides={"fps": 15.0, "width": 32, "height": 24, "codec": "ffv1"})
+    monkeypatch.setenv("WALLCLI_CACHE", str(tmp_path / "cache"))
+    m = build_dataset(tmp_path / "d", 2, "count", seed=1, jobs=1, world="pt", windows_per_scene=1, shard_scenes=2,
+                      grid=(4, 6), spp=2, camera_overrides={"width": 32, "height": 24, "codec": "ffv1"}, draws=2)
     assert m["recipe"]["world"] == "pt" and m["recipe"]["spp"] == 2 and m["complete"]
+    assert m["recipe"]["clean_cache"]["draws"] == 2
     arrays, meta = load_npz(tmp_path / "d" / "shard-00000.npz", kind="wallcli.dataset-shard")
-    assert meta["scenes"][0]["world"] == "pt" and arrays["horizontal"].shape == (1, 64, 256, 3)
+    assert meta["scenes"][0]["world"] == "pt" and arrays["horizontal"].shape == (2, 64, 256, 3)
     assert np.isfinite(arrays["horizontal"]).all()
+    # two draws of one clean scene, rendered once into the cache: the same scene under two cameras
+    assert [s["index"] for s in meta["scenes"]] == [0, 0] and [s["draw"] for s in meta["scenes"]] == [0, 1]
+    assert len(list((tmp_path / "cache" / "pt").glob("*/scene-*.npz"))) == 1

@@ -58,6 +58,10 @@ def simulate(
                               "motions path traced by Mitsuba 3 (people of boxes, three bounces; needs "
                               "pip install 'wallcli[pt]'; slow on a CPU, meant for a GPU); mixed (--dataset only): room "
                               "with some flatland count scenes."),
+    draws: int = number_option(1, "--draws", lo=1, hi=1000, integer=True, help="--dataset --world pt: cameras drawn "
+                               "over each clean path-traced scene (noise, gain, tone curve, codec, lighting nuisances "
+                               "afresh each time); the clean scenes are rendered once into $WALLCLI_CACHE/pt "
+                               "(default ~/.cache/wallcli/pt) and reused by later runs."),
     spp: int = number_option(256, "--spp", lo=1, hi=65536, integer=True, help="--world pt: path-traced samples per wall point "
                              "and frame (Monte Carlo noise in the people's signal falls as 1/sqrt(spp))."),
     domain: str = typer.Option("base", "--domain", help="base: training ranges; shifted: moved ranges of room size, lights, "
@@ -140,7 +144,7 @@ def simulate(
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
-                        json_out, placement, spp)
+                        json_out, placement, spp, draws)
     if world == "mixed":
         raise UsageError("--world mixed is for --dataset; a single video is room, flatland or pt")
     acts = [a.strip() for a in activity.split(",") if a.strip()]
@@ -239,7 +243,8 @@ def _finish(output, tmp_video, sidecar, truth, preview, json_out, force) -> None
             "persons": [{k: v for k, v in p.items() if k != "positions"} for p in truth.get("persons", [])]})
 
 
-def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out, placement, spp=256) -> None:
+def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out, placement, spp=256,
+             draws=1) -> None:
     import os
     import time
 
@@ -261,7 +266,7 @@ def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid
     with progress(f"dataset ({task})", n) as advance:
         manifest = build_dataset(output, n, task, seed=seed, jobs=jobs, domain=domain, world=world,
                                  windows_per_scene=wps, shard_scenes=shard_scenes, grid=grid_rc, force=force, placement=placement,
-                                 spp=spp,
+                                 spp=spp, draws=draws,
                                  advance=advance, log=lambda m: console_err.print(m))
     dt = time.perf_counter() - t0
     console_err.print(f"wrote {n} windows in {len(manifest['shards'])} shard(s) to {output} in {dt:.1f} s")

@@ -25,7 +25,8 @@ CLASSES = {"count": [0, 1, 2], "activity": list(ACTIVITIES)}
 ARRAYS = ("horizontal", "vertical", "label", "people", "activity", "snr_db", "snr_db_weakest", "h_offset", "v_offset")
 
 
-def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible", spp=256) -> dict:
+def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement="visible", spp=256,
+           draws=1) -> dict:
     rec = {"task": task, "seed": int(seed), "windows": int(n), "domain": domain, "world": world,
             "windows_per_scene": int(windows_per_scene), "shard_scenes": int(shard_scenes), "grid": list(grid),
             "placement": placement, "generator": "wallcli.datagen v1",
@@ -33,6 +34,8 @@ def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, 
             "physics": "room-shadows"}
     if world == "pt":  # path traced: its sample count is part of the data (other worlds' recipes unchanged)
         rec["spp"] = int(spp)
+        # clean scenes from the cache (datagen/ptcache.py), each under `draws` fresh cameras
+        rec["clean_cache"] = {"format": "wallcli.pt-clean-scene", "version": 1, "draws": int(draws)}
     if task == "count":  # the movers' activity mix (a dataset made with another mix is another dataset)
         rec["count_activities"] = dict(zip(*COUNT_ACTS))
     return rec
@@ -63,7 +66,16 @@ def _shard_ok(path: Path, keep: int) -> bool:
 
 
 def _work(args):
-    seed, index, task, domain, world, wps, grid, cam, placement, spp = args
+    seed, index, task, domain, world, wps, grid, cam, placement, spp, draws = args
+    if world == "pt":
+        # the path tracer's clean irradiance is rendered once and cached outside the work tree;
+        # scene `index` is clean scene index // draws under camera draw index % draws
+        from wallcli.datagen import ptcache
+
+        rec = ptcache.recipe(seed=seed, task=task, domain=domain, placement=placement, grid=grid, spp=spp)
+        arrays, meta = ptcache.ensure_scene(rec, index // draws)
+        return index, ptcache.compose_windows(arrays, meta, index % draws, windows=wps, domain=domain,
+                                              camera_overrides=cam)
     out = render_windows(seed, index, task, domain=domain, world=world, windows=wps, grid=tuple(grid),
                          camera_overrides=cam, placement=placement, spp=spp)
     return index, out
@@ -89,7 +101,8 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
                   domain: str = "base", world: str = "room", windows_per_scene: int = 4,
                   shard_scenes: int = 32, grid=(24, 32), force: bool = False,
                   advance: Callable[[int], None] | None = None, log: Callable[[str], None] | None = None,
-                  camera_overrides: dict | None = None, placement: str = "visible", spp: int = 256) -> dict:
+                  camera_overrides: dict | None = None, placement: str = "visible", spp: int = 256,
+                  draws: int = 1) -> dict:
     """Write (or finish) the dataset in ``out_dir``; returns the manifest.
 
     ``camera_overrides`` fixes camera parameters for every scene (tests, special sets); it is
@@ -100,7 +113,7 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
     from wallcli.io.writer import output_folder, write_text_atomic
 
     out = output_folder(out_dir)
-    rec = recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement, spp)
+    rec = recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, placement, spp, draws)
     if camera_overrides:
         rec["camera_overrides"] = dict(camera_overrides)
     manifest_path = out / "dataset.json"
@@ -132,7 +145,7 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
         log(f"resuming: {len(plan) - len(todo)} of {len(plan)} shards already done")
     pending = {k: {"idx": idx, "keep": keep, "got": {}} for k, idx, keep in todo}
     owner = {i: k for k, idx, _ in todo for i in idx}
-    tasks = [(seed, i, task, domain, world, windows_per_scene, list(grid), camera_overrides, placement, spp)
+    tasks = [(seed, i, task, domain, world, windows_per_scene, list(grid), camera_overrides, placement, spp, draws)
              for k, idx, _ in todo for i in idx]
     if tasks:
         ctx = mp.get_context("fork") if hasattr(os, "fork") else mp.get_context()

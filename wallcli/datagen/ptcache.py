@@ -173,7 +173,7 @@ class _Profiles:
 
 
 def compose_windows(arrays: dict, meta: dict, draw: int, *, windows: int = 4, tmpdir: str | None = None,
-                    domain: str = "wide") -> dict:
+                    domain: str = "wide", camera_overrides: dict | None = None) -> dict:
     """Windows of one cached scene under camera draw ``draw``: a fresh camera (noise, gain, tone
     curve, vignetting, codec, lighting nuisances) at the scene's frame rate, a real video file, and
     the real stplot path, exactly as :func:`wallcli.datagen.clips.render_windows` makes them."""
@@ -190,6 +190,9 @@ def compose_windows(arrays: dict, meta: dict, draw: int, *, windows: int = 4, tm
     rec = meta["recipe"]
     rng = np.random.default_rng(np.random.SeedSequence([rec["seed"], meta["index"], 11, int(draw)]))
     cam = sample_camera(rng, domain)
+    for k, v in (camera_overrides or {}).items():  # tests, special sets; never the frame rate (the scene's)
+        if k != "fps":
+            setattr(cam, k, v)
     cam.fps = float(meta["fps"])
     E0, dE = arrays["E0"], arrays["dE"]
     T = len(dE)
