@@ -119,12 +119,12 @@ def test_bad_labels_and_usage(tmp_path, run_cli):
 def test_one_decode_per_clip_gives_both_the_answer_and_the_snr(sims, single, monkeypatch):
     import wallcli.io.video as video
     from wallcli.evaluate.clip import measure_clip
-    from wallcli.infer.model import load_model
+    from wallcli.infer.twostage import load_classifier
 
     opened = []
     real = video.open_video
     monkeypatch.setattr(video, "open_video", lambda src, **kw: opened.append(src) or real(src, **kw))
-    model = load_model("count")
+    model = load_classifier("count")  # the two-stage count, as `wallcli count` answers
     out = measure_clip(model, sims / "walk.mp4", stride=int(model.card["stride"]))
     assert opened == [str(sims / "walk.mp4")]
     assert out["result"]["probabilities"] == single["count", "walk.mp4"]["probabilities"]
