@@ -88,7 +88,10 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
     tasks = tuple(t for t in TASKS if t in tasks)
     # the results file inside a scanned folder is not a video: running the command again resumes
     sources = expand_inputs([str(i) for i in inputs], globs, skip=Path(output))
-    out = check_output(output, force=True, inputs=[s for s in sources if not is_url(s)])
+    from wallcli.infer.model import shipped_model_path
+
+    out = check_output(output, force=True, inputs=[*(s for s in sources if not is_url(s)),
+                                                   *(shipped_model_path(t) for t in CLASSIFY if t in tasks)])
     columns = csv_columns(tasks, _classes(tasks), windows) if is_csv(out) else None
     results = ResultsFile(out, encode, columns)
     results.open()  # and locked: from here to the end, no other scan writes it

@@ -49,8 +49,10 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     from wallcli.infer.model import load_model
     from wallcli.io.writer import check_outputs, committed_together
 
-    # the model is an input too: --plot over it must not replace it
-    check_outputs([plot], force=force, inputs=[input, model_path])
+    from wallcli.infer.model import shipped_model_path
+
+    # the model and its card are inputs too: --plot over either must not replace it
+    check_outputs([plot], force=force, inputs=[input, model_path or shipped_model_path(task)])
     model = load_model(task, model_path, threads=threads)
     stride = int(stride or model.card["stride"])
 

@@ -63,7 +63,10 @@ def report(
     from wallcli.cli.output import progress, warn
     from wallcli.io.writer import check_outputs, write_text_atomic
 
-    check_outputs([output], force=force, inputs=[input, count_model, activity_model])
+    from wallcli.infer.model import shipped_model_path
+
+    check_outputs([output], force=force, inputs=[input, count_model or shipped_model_path("count"),
+                                                 activity_model or shipped_model_path("activity")])
     command = _command_line(input, output, roi, count_model, activity_model, force, threads)
     if results:
         from wallcli.report.pages import scan_page
