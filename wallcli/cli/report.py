@@ -57,8 +57,9 @@ def report(
         raise UsageError(f"-o must end in .html (got {output})")
     roi_t = parse_roi(roi)
     results = str(input).lower().endswith(RESULTS_SUFFIXES)
-    if results and (roi_t or count_model or activity_model):
-        raise UsageError("--roi, --count-model and --activity-model apply to a video; scan results are already analysed")
+    if results and (roi_t or count_model or activity_model or no_deflicker or no_exposure or no_shake):
+        raise UsageError("--roi, --count-model, --activity-model and --no-deflicker/--no-exposure/--no-shake apply "
+                         "to a video; scan results are already analysed (scan records its options in each line)")
 
     from wallcli.cli.output import progress, warn
     from wallcli.io.writer import check_outputs, write_text_atomic
@@ -67,7 +68,8 @@ def report(
 
     check_outputs([output], force=force, inputs=[input, count_model or shipped_model_path("count"),
                                                  activity_model or shipped_model_path("activity")])
-    command = _command_line(input, output, roi, count_model, activity_model, force, threads)
+    command = _command_line(input, output, roi, count_model, activity_model, force, threads,
+                            strict=strict, no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake)
     if results:
         from wallcli.report.pages import scan_page
         from wallcli.report.scan import read_results, summarise
@@ -75,6 +77,13 @@ def report(
         records, problems = read_results(input)
         for p in problems:
             warn(p)
+        if strict:  # as for a video: an unusable view is the input's error, before any page is written
+            bad = [r for r in records if isinstance(r.get("view"), dict) and r["view"].get("usable") is False]
+            if bad:
+                from wallcli.errors import WallcliError
+
+                raise WallcliError(f"{len(bad)} video(s) in {input} not a static view of a wall (--strict), first "
+                                   f"{bad[0].get('input')}: {bad[0]['view'].get('reason') or 'not a static view'}")
         html = scan_page(str(input), summarise(records), problems, command=command)
     else:
         from wallcli.report.analysis import analyse, load_models
@@ -100,12 +109,19 @@ def report(
     wrote((output, f"{what}, {shown}, self-contained: open it in any browser"))
 
 
-def _command_line(input, output, roi, count_model, activity_model, force, threads) -> str:
-    """The command as given, in canonical form (options in a fixed order; the same in-process)."""
+def _command_line(input, output, roi, count_model, activity_model, force, threads, *, strict=False,
+                  no_deflicker=False, no_exposure=False, no_shake=False) -> str:
+    """The command as given, in canonical form (options in a fixed order; the same in-process):
+    every option that changes an answer (or the exit status) is in it, so running it again gives
+    this page's answers."""
     args = ["wallcli", "report", str(input), "-o", str(output)]
     for flag, value in (("--roi", roi), ("--count-model", count_model), ("--activity-model", activity_model)):
         if value is not None:
             args += [flag, str(value)]
+    for flag, on in (("--no-deflicker", no_deflicker), ("--no-exposure", no_exposure), ("--no-shake", no_shake),
+                     ("--strict", strict)):
+        if on:
+            args.append(flag)
     if threads:
         args += ["--threads", str(threads)]
     if force:

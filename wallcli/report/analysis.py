@@ -38,6 +38,8 @@ class ClipAnalysis:
     failures: dict[str, str] = field(default_factory=dict)  # task -> why it has no verdict
     warnings: list[str] = field(default_factory=list)
     view: dict[str, Any] = field(default_factory=dict)  # the view check's verdict on the clip
+    options: Any = None  # the corrections asked for (wallcli.signal.corrections.Options)
+    snr_corrections: list = field(default_factory=list)  # what the SNR estimator's corrections found
 
 
 class _Tee:
@@ -155,8 +157,12 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         "wallcli_version": __version__,
         "generated": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
+    from wallcli.signal.corrections import Options
+
     out = ClipAnalysis(str(source), identity, tuple(plot.meta["roi"]), plot, snr, tee.grid, tee.first, models,
-                       warnings=notes, view=tee.view.summary())
+                       warnings=notes, view=tee.view.summary(),
+                       options=corrections if corrections is not None else Options(),
+                       snr_corrections=list(tee.snr.corrections))
     for task in TASKS:
         model = models[task]
         try:
