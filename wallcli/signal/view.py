@@ -88,6 +88,7 @@ KINDS = {
     "clipped": "much of the frame is clipped",
     "too dark": "much of the frame is too dark",
     "too little usable area": "too little of the frame is usable",
+    "too thin to check": "the frame is too thin to check for camera motion",
 }
 
 
@@ -444,10 +445,16 @@ class ViewCheck:
         level = np.maximum(blocks, DARK)
         # camera motion: a shift of the frame's fine structure against the reference frame that
         # explains more of the change than the noise could
-        if self._window is None or self._window.shape != hp.shape:
-            self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
-        # copies: OpenCV applies the window to its inputs in place
-        (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
+        if min(hp.shape) < 2:
+            # a frame one sample thin at the check's scale (4000x16, 1x1000) has no second dimension
+            # to register on (OpenCV's window needs two): its motion cannot be judged, so say so
+            flags.add("too thin to check")
+            dx = dy = 0.0
+        else:
+            if self._window is None or self._window.shape != hp.shape:
+                self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
+            # copies: OpenCV applies the window to its inputs in place
+            (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
         shift = float(np.hypot(dx, dy)) * self._scale
         moved = False
         # a shift of half the floor that fits is not motion yet, but a shake on its way to it:
