@@ -24,10 +24,13 @@ from wallcli.signal.window import StreamWindower, resample, window_signal_db, wi
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
 
 
-def _too_short(source: str, frames: int, model) -> WallcliError:
+def _too_short(source: str, frames: int, model, fps: float | None = None) -> WallcliError:
+    """``frames``: the file's own frames, as decoded (what snr and the report quote), at its own
+    rate ``fps`` (None: the model's), not the resampled samples the windows are cut from."""
+    fps = float(fps) if fps else float(model.fps)
     return WallcliError(
-        f"{source} is too short: {frames} frame(s) at {model.fps:g} fps ({frames / model.fps:.2f} s); "
-        f"one window needs {model.window} frames ({model.window / model.fps:.2f} s)")
+        f"{source} is too short: {frames} frame(s) decoded ({frames / fps:.2f} s at {fps:g} fps); "
+        f"one window needs {model.window / model.fps:.2f} s ({model.window} frames at {model.fps:g} fps)")
 
 
 def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> dict[str, Any]:
@@ -110,7 +113,7 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
     frames = len(grid) if plot.frames >= 2 else plot.frames
     starts = window_starts(frames, model.window, stride)
     if not starts:
-        raise _too_short(source, frames, model)
+        raise _too_short(source, plot.frames, model, native_fps(plot.time))
     probs, signal, found = [], [], []
     native = native_fps(plot.time)
     for i in range(0, len(starts), CHUNK):
@@ -182,12 +185,14 @@ class WindowClassifier:
             self.found.append(f)
             self._emitted = self.windower.count
 
-    def result(self, source: str) -> dict[str, Any]:
-        """The docs/contract.md result; WallcliError when the stream was shorter than one window."""
+    def result(self, source: str, frames: int | None = None) -> dict[str, Any]:
+        """The docs/contract.md result; WallcliError when the stream was shorter than one window
+        (quoting ``frames``, the video's decoded frames, where given)."""
         model, w = self.model, self.windower
         last = w.last()
         if last is None:
-            raise _too_short(str(source), w.count, model)
+            raise _too_short(str(source), w.count if frames is None else frames, model,
+                             None if frames is None else self.native_fps)
         times, probs, signal, found = list(self.times), list(self.probs), list(self.signal), list(self.found)
         if self._emitted != w.count:  # window_starts' end-aligned window: the last `window` rows
             p, db, f = _predict_window(model, last[2], self.ref, start=last[0], native=self.native_fps,
@@ -247,7 +252,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             if thumb is not None:
                 thumb.push(t, row)
             classifier.push(t, stream_row(row, rows), rows.ref)
-    result = with_view(classifier.result(str(source)), check)
+    result = with_view(classifier.result(str(source), frames=rows.frames), check)
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
@@ -310,4 +315,4 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
                 rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
                 yield judge_view(rec, check.view(rec["start"], rec["end"]))
     if windower.count < model.window:
-        raise _too_short(str(source), windower.count, model)
+        raise _too_short(str(source), rows.frames, model, float(reader.info.fps))
