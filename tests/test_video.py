@@ -187,3 +187,17 @@ def test_repeatable_writer_gives_the_same_h264_file_every_time(tmp_path):
                 w.write(f)
         files.append(out.read_bytes())
     assert all(f == files[0] for f in files[1:])
+
+
+@pytest.mark.parametrize("fps", [Fraction(1, 2), Fraction(500)])
+def test_a_frame_rate_outside_what_wallcli_reads_is_refused_alike_everywhere(tmp_path, run_cli, fps):
+    """Issue 38 item 5: a 0.5 fps file gave count eight windows and 32 dB, snr -99 dB."""
+    clip = write_clip(tmp_path / "slow.mkv", lambda i: np.full((32, 32, 3), 100.0) + i % 5, 12, fps=fps,
+                      codec="ffv1", pix_fmt="yuv444p", options={})
+    lines = set()
+    for args in (["count"], ["activity"], ["snr"], ["stplot", "-o", tmp_path / "p.npz"],
+                 ["amplify", tmp_path / "a.mp4"], ["report", "-o", tmp_path / "r.html"]):
+        code, out, err = run_cli(args[0], clip, *args[1:])
+        assert code == 1 and out == "" and err.count("\n") == 1 and "fps" in err, (args, err)
+        lines.add(err)
+    assert len(lines) == 1  # word for word the same line

@@ -107,6 +107,10 @@ def _corrected(model, wins: dict, offsets: dict, native, options, starts=None, s
 
 def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
+    from wallcli.io.video import check_rate
+
+    if native_fps(plot.time) is not None:  # a plot of an older wallcli, made before videos were checked
+        check_rate(native_fps(plot.time), source)
     plots, grid = resampled_plots(model, plot, both=corrections.light)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}

@@ -36,6 +36,20 @@ _SUB = {"420": (1, 1), "422": (1, 0), "444": (0, 0), "440": (0, 1), "411": (2, 0
 
 _QUEUE_SIZE = 8
 
+# The frame rates wallcli reads. The models see 8.5 s windows resampled to 30 fps, trained on 15-60 fps
+# videos, and the SNR estimator (paper suppl. 3.2) takes what lasts from one frame to the next as
+# signal: far below 10 fps a person moves across the wall between two frames and both would be
+# answering about interpolated samples (a 0.5 fps file gave eight windows and 32 dB, snr -99 dB);
+# far above 240 fps, the timestamps of slow-motion files are rarely the capture's.
+MIN_FPS, MAX_FPS = 10.0, 240.0
+
+
+def check_rate(fps: float, source: str) -> None:
+    """Refuse a frame rate outside MIN_FPS-MAX_FPS: one line, the same for every command."""
+    if not (MIN_FPS <= float(fps) <= MAX_FPS):
+        raise WallcliError(f"{source}: {float(fps):.3g} fps; wallcli reads videos of {MIN_FPS:g} to {MAX_FPS:g} fps "
+                           "(the models' windows and the SNR estimator assume frames a fraction of a second apart)")
+
 
 @dataclass
 class VideoInfo:
@@ -240,6 +254,11 @@ class VideoReader:
             rate = Fraction(30)
             self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
         fps = Fraction(rate).limit_denominator(1001)
+        try:
+            check_rate(fps, source)
+        except WallcliError:
+            self._container.close()
+            raise
         count = int(stream.frames or 0) or None
         self._declared_frames = count  # exact where the container says (mp4); estimates are not
         duration = None
