@@ -10,6 +10,7 @@ import pytest
 
 from clips import write_clip
 from wallcli.errors import WallcliError
+import wallcli.io.video as video
 from wallcli.io.video import open_video
 from wallcli.signal.blocks import rgb_grid
 
@@ -201,3 +202,46 @@ def test_a_frame_rate_outside_what_wallcli_reads_is_refused_alike_everywhere(tmp
         assert code == 1 and out == "" and err.count("\n") == 1 and "fps" in err, (args, err)
         lines.add(err)
     assert len(lines) == 1  # word for word the same line
+
+
+def _gappy(tmp_path, lost=70, n=290):
+    """A wall clip at 30 fps whose frames 90 to 90 + lost are gone: the timestamps jump."""
+    def frame(i):
+        return np.full((48, 64, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (48, 64, 3))
+
+    return write_clip(tmp_path / "gap.mp4", frame, n, fps=30, pts_fn=lambda i: i if i < 90 else i + lost,
+                      time_base=Fraction(1, 30))
+
+
+def test_a_jump_of_the_timestamps_is_a_gap(tmp_path):
+    clip = _gappy(tmp_path)
+    with video.open_video(clip) as r:
+        with pytest.warns(video.VideoWarning, match="frames missing"):
+            frames = [(f.time, f.gap) for f in r.frames()]
+        assert r.gaps == [(pytest.approx(89 / 30, abs=1e-3), pytest.approx(160 / 30, abs=1e-3))]
+    assert [g for _, g in frames if g] == [pytest.approx(71 / 30, abs=1e-3)]
+    # a whole clip without lost frames has none
+    write_clip(tmp_path / "ok.mp4", lambda i: np.full((16, 16, 3), 100.0), 40, fps=30)
+    with video.open_video(tmp_path / "ok.mp4") as r:
+        assert not any(f.gap for f in r.frames()) and r.gaps == []
+
+
+def test_windows_across_a_gap_are_not_relied_upon_and_the_json_lists_it(tmp_path, run_cli):
+    """Issue 38 item 4: 2.4 s of lost frames changed count 1 -> 2 with only a corrupt-packet note."""
+    import json
+
+    clip = _gappy(tmp_path)
+    code, out, err = run_cli("count", clip, "--json")
+    assert code == 0 and "frames missing" in err
+    res = json.loads(out)
+    assert "frame gap" in res["view"]["issues"] and res["confident"] is False
+    assert "frames missing at 3.0-5.3 s" in res["reason"]
+    for w in res["windows"]:
+        crosses = w["start"] <= 160 / 30 and w["end"] >= 89 / 30
+        assert (w["confident"] is False and "frame gap" in w["view"]["issues"]) if crosses else True
+    code, out, err = run_cli("snr", clip, "--json")
+    snr = json.loads(out)
+    assert code == 0 and any("frames missing" in w for w in snr["warnings"])  # (stderr: once a process)
+    assert snr["view"]["gaps"] == [[pytest.approx(89 / 30, abs=1e-3), pytest.approx(160 / 30, abs=1e-3)]]
+    code, _, err = run_cli("count", clip, "--strict")
+    assert code == 1 and "frames missing" in err

@@ -150,6 +150,15 @@ class Frame:
     time: float
     planes: Planes
     _keep: object = field(default=None, repr=False)  # the av.VideoFrame whose buffers the planes view
+    gap: float = 0.0  # seconds since the frame before, when the timestamps jump there (frames lost): 0 otherwise
+
+
+# A jump of the timestamps over GAP_FACTOR typical frame intervals, and over GAP_MIN seconds, is frames
+# lost (corruption, a dropped stretch of a stream), not a variable frame rate's slower frame (phones:
+# up to about 2x; a few frames' pause is interpolated over like any resampling)
+GAP_FACTOR = 5.0
+GAP_MIN = 0.25
+GAP_HISTORY = 16  # recent intervals whose median is the typical one
 
 
 def _plane_array(plane, width: int, height: int, dtype) -> np.ndarray:
@@ -282,6 +291,7 @@ class VideoReader:
         )
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs
+        self.gaps: list[tuple[float, float]] = []  # (time of the frame before, time of the frame after) per jump
 
     # -- decoding -------------------------------------------------------------------------------
     def _decode_into(self, q: "queue.Queue", stop: threading.Event) -> None:
@@ -326,6 +336,10 @@ class VideoReader:
         last_time = -np.inf
         tb = self._stream.time_base
         fps = float(self.info.fps)
+        from collections import deque
+
+        recent: deque = deque(maxlen=GAP_HISTORY)
+        self.gaps = []
         try:
             while True:
                 kind, item = q.get()
@@ -340,8 +354,17 @@ class VideoReader:
                     if t <= last_time:
                         # Duplicate or out-of-order timestamps (broken muxers): keep time monotonic.
                         t = last_time + 1.0 / fps
+                    gap = 0.0
+                    if index:
+                        dt = t - last_time
+                        typical = float(np.median(recent)) if len(recent) >= 4 else 1.0 / fps
+                        if dt > GAP_FACTOR * typical and dt > max(GAP_FACTOR / fps, GAP_MIN):
+                            gap = dt
+                            self.gaps.append((round(last_time, 4), round(t, 4)))
+                        else:
+                            recent.append(dt)
                     last_time = t
-                    yield Frame(index, t, frame_planes(frame), frame)
+                    yield Frame(index, t, frame_planes(frame), frame, gap)
                     index += 1
                 elif kind == "damage":
                     self._warn(f"{self.source}: the stream is damaged after frame {index} ({item}); "
@@ -351,6 +374,11 @@ class VideoReader:
                 else:
                     if item:
                         self._warn(f"{self.source}: skipped {item} corrupt packet(s)/frame(s)")
+                    if self.gaps:
+                        shown = ", ".join(f"{b - a:.2f} s after {a:.2f} s" for a, b in self.gaps[:3])
+                        more = f" and {len(self.gaps) - 3} more" if len(self.gaps) > 3 else ""
+                        self._warn(f"{self.source}: frames missing (the timestamps jump): {shown}{more}; "
+                                   "what spans a gap is not analysed as continuous (view: 'frame gap')")
                     self._check_complete(index, last_time)
                     break
         finally:

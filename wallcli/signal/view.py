@@ -89,6 +89,9 @@ KINDS = {
     "too dark": "much of the frame is too dark",
     "too little usable area": "too little of the frame is usable",
     "too thin to check": "the frame is too thin to check for camera motion",
+    # not the view's fault but the file's: frames lost (their timestamps jump, io.video.GAP_FACTOR);
+    # nothing spanning it is continuous video
+    "frame gap": "frames are missing",
 }
 
 
@@ -264,7 +267,18 @@ class ViewCheck:
         self._bad_geometry = None
 
     def __call__(self, frame) -> None:
+        gap = getattr(frame, "gap", 0.0)
+        if gap:
+            self.gap(frame.time - gap, frame.time)
         self.update(frame.time, frame.planes)
+
+    def gap(self, start: float, end: float) -> None:
+        """Frames are missing between ``start`` and ``end`` (the times of the frames either side)."""
+        spans = self.spans["frame gap"]
+        if len(spans) >= MAX_SPANS:
+            spans[-1][1] = end
+        else:
+            spans.append([round(float(start), 4), round(float(end), 4)])
 
     # ------------------------------------------------------------------ per frame
     def update(self, t: float, planes) -> None:
@@ -543,14 +557,17 @@ class ViewCheck:
             return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked"}
         reason = None
         if issues:
-            parts = [f"{k} at {_spans_text(found[k])}" for k in issues]
-            reason = "not a static view of the wall: " + "; ".join(parts)
+            parts = [f"{k} at {_spans_text(found[k])}" for k in issues if k != "frame gap"]
+            reason = "; ".join((["not a static view of the wall: " + "; ".join(parts)] if parts else [])
+                               + ([f"frames missing at {_spans_text(found['frame gap'])}"]
+                                  if found["frame gap"] else []))
         return {"usable": not issues, "issues": issues, "reason": reason}
 
     def summary(self) -> dict:
         """The clip's view and what it was judged on (extra fields of the JSON's ``view``)."""
         noise = float(np.median(self._sig_b)) if self._sig_b else None
-        return {**self.view(), "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
+        return {**self.view(), "gaps": [list(s) for s in self.spans["frame gap"]],
+                "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
                 "min_usable_area": round(self.min_usable, 3),
                 "noise": None if noise is None else round(noise, 4)}
 
