@@ -242,3 +242,23 @@ def test_a_one_pixel_wide_clip_gets_its_report(tmp_path, run_cli):
     clip = write_clip(tmp_path / "thin.nut", frame, 12, fps=30, codec="rawvideo", pix_fmt="yuv444p", options={})
     code, _, err = run_cli("report", clip, "-o", tmp_path / "r.html")
     assert code == 0 and "internal error" not in err, err
+
+
+def test_answers_from_a_plot_carry_the_videos_view(run_cli, crossing, tmp_path):
+    """Issue 38 item 3: stplot keeps the view verdict in the .npz; count/activity read from it carry
+    it (windows and clip), and --strict refuses it, as from the video."""
+    npz = tmp_path / "p.npz"
+    code, out, err = run_cli("stplot", crossing, "-o", npz, "--json")
+    assert code == 0, err
+    assert json.loads(out)["view"]["usable"] is False
+    code, out, _ = run_cli("count", crossing, "--json")
+    from_video = json.loads(out)
+    code, out, err = run_cli("count", npz, "--json")
+    assert code == 0, err
+    r = json.loads(out)
+    assert r["view"]["usable"] is False and r["view"]["issues"] == from_video["view"]["issues"]
+    assert r["confident"] is False and r["reason"] == from_video["view"]["reason"]
+    assert [w["view"]["usable"] for w in r["windows"]] == [w["view"]["usable"] for w in from_video["windows"]]
+    for cmd in ("count", "activity"):
+        code, out, err = run_cli(cmd, npz, "--strict")
+        assert code == 1 and out == "" and "moving object" in err

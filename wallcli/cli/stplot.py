@@ -57,16 +57,29 @@ def stplot(
     from wallcli.io.writer import check_outputs, committed_together
     from wallcli.signal.stplot import compute_stplot
 
+    from wallcli.io.video import FrameTee
+    from wallcli.signal.view import ViewCheck
+
     check_outputs([output, png], force=force, inputs=[input])
+    # the view check and the camera's shifts ride on the same decode: the .npz keeps both, so that
+    # count and activity read from it answer as they would from the video (view verdict, shake)
+    check = ViewCheck(roi_t)
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
-            plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)
+            plot = compute_stplot(FrameTee(reader, (check,)), roi=roi_t, bins=bins, mean=mean,
+                                  mean_seconds=mean_seconds, progress=advance, register=True, view=check)
     with committed_together():  # the .npz, the PNG and the JSON: all or none
         _write(plot, input, output, png, style, gain, json_out, force)
     from wallcli.cli.output import wrote
 
     shape = f"{plot.bins} positions x {plot.frames} frames"
     wrote((output, f"horizontal and vertical space-time plots, {shape}"), (png, "both plots, amplified"))
+
+
+def check_summary(meta: dict) -> dict | None:
+    from wallcli.signal.view import ViewCheck
+
+    return ViewCheck.restore(meta["view"]).summary() if isinstance(meta.get("view"), dict) else None
 
 
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:
@@ -88,4 +101,5 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
             "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
             "signal_rms": [float(x) for x in plot.horizontal.std(axis=(0, 1))],
             "warnings": m.get("warnings", []),
+            "view": check_summary(m),
         })

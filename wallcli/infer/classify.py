@@ -30,7 +30,7 @@ def _too_short(source: str, frames: int, model, fps: float | None = None) -> Wal
     fps = float(fps) if fps else float(model.fps)
     return WallcliError(
         f"{source} is too short: {frames} frame(s) decoded ({frames / fps:.2f} s at {fps:g} fps); "
-        f"one window needs {model.window / model.fps:.2f} s ({model.window} frames at {model.fps:g} fps)")
+        f"one window needs {model.window} frames at {model.fps:g} fps ({model.window / model.fps:.2f} s)")
 
 
 def _window_record(model, start: float, probs: np.ndarray, signal_db: float) -> dict[str, Any]:
@@ -112,6 +112,12 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
     if native_fps(plot.time) is not None:  # a plot of an older wallcli, made before videos were checked
         check_rate(native_fps(plot.time), source)
     plots, grid = resampled_plots(model, plot, both=corrections.light)
+    shifts = None
+    if corrections.shake and getattr(plot, "shift", None) is not None and plot.frames >= 2:
+        # resampled as the profiles are, as the stream's extra row is (RowStream)
+        ext = np.zeros((1, plot.frames, 3), np.float32)
+        ext[0, :, :2] = plot.shift
+        shifts = resample(ext, plot.time, model.fps)[0][0, :, :2].astype(np.float64)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     frames = len(grid) if plot.frames >= 2 else plot.frames
@@ -124,13 +130,20 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
         chunk = starts[i:i + CHUNK]
         wins = {name: np.stack([p[:, s:s + model.window] for s in chunk]) for name, p in plots.items()}
         wins, f = _corrected(model, wins, {n: offsets[n][None] for n in wins}, native, corrections,
-                             starts=[grid[s] for s in chunk])
+                             starts=[grid[s] for s in chunk],
+                             shifts=None if shifts is None else np.stack([shifts[s:s + model.window] for s in chunk]))
         found += f
         wins = {name: wins[name] for name in model.input_names}
         probs.append(model.predict({name: model.normalize(w, offsets[name][None]) for name, w in wins.items()}))
         signal.append(window_signal_db([(w, offsets[name][None]) for name, w in wins.items()]))
-    return _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
-                   stride=stride, source=source, found=found)
+    result = _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
+                     stride=stride, source=source, found=found)
+    view = (plot.meta or {}).get("view")
+    if isinstance(view, dict):  # the verdict of the video's check, kept by stplot
+        from wallcli.signal.view import ViewCheck
+
+        result = with_view(result, ViewCheck.restore(view))
+    return result
 
 
 def _predict_window(model, win: np.ndarray, ref: np.ndarray, *, start: float = 0.0, native=None,

@@ -563,6 +563,27 @@ class ViewCheck:
                                   if found["frame gap"] else []))
         return {"usable": not issues, "issues": issues, "reason": reason}
 
+    def record(self) -> dict:
+        """What :meth:`view` and :meth:`summary` answer from, as JSON (a .npz plot's metadata
+        keeps it, so answers read from the plot carry the verdict of the video's check)."""
+        return {"spans": {k: [list(s) for s in v] for k, v in self.spans.items()}, "frames": self.frames,
+                "max_shift": self.max_shift, "min_usable": self.min_usable,
+                "noise": float(np.median(self._sig_b)) if self._sig_b else None}
+
+    @classmethod
+    def restore(cls, record: dict) -> "ViewCheck":
+        """A check that answers as the one whose :meth:`record` this is (nothing more is fed to it)."""
+        check = cls()
+        spans = record.get("spans") or {}
+        for kind in check.spans:  # kinds of a newer wallcli are not this one's to judge
+            check.spans[kind] = [[float(a), float(b)] for a, b in spans.get(kind, [])]
+        check.frames = int(record.get("frames") or 0)
+        check.max_shift = float(record.get("max_shift") or 0.0)
+        check.min_usable = float(record.get("min_usable", 1.0))
+        if record.get("noise") is not None:
+            check._sig_b.append(float(record["noise"]))
+        return check
+
     def summary(self) -> dict:
         """The clip's view and what it was judged on (extra fields of the JSON's ``view``)."""
         noise = float(np.median(self._sig_b)) if self._sig_b else None
