@@ -74,7 +74,7 @@ def clip_page(a, *, command: str) -> str:
         snr={"rows": _snr_rows(a.snr), "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
              "pixels": a.snr.sampled_pixels, "channels": CHANNELS},
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
-        plot={"bins": a.plot.bins, "frames": a.plot.frames},
+        plot={"bins": a.plot.bins, "frames": a.identity["frames"]},
         figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],
         corrections=corrections_view(a), view=a.view,
     )
