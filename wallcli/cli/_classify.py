@@ -35,9 +35,11 @@ NO_SHAKE_OPT = shake_option()
 def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
-        no_shake: bool = False) -> None:
+        no_shake: bool = False, stream: Optional[int] = None) -> None:
+    from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 
+    use_stream(stream)
     roi_t = parse_roi(roi)
     fixes = corrections_of(no_deflicker, no_exposure, no_shake)
     if follow and plot is not None:

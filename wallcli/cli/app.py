@@ -148,6 +148,9 @@ def _run(argv: list[str] | None) -> int:
     if argv is None:
         _fill_closed_fds()
     command = typer.main.get_command(app)
+    video = sys.modules.get("wallcli.io.video")
+    if video is not None:  # a command run before this one in the process (tests, scripts) chose a stream
+        video.STREAM.set(None)
     try:
         with guarded_stdout():
             rv = command.main(args=argv, prog_name="wallcli", standalone_mode=False)

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (stream_option, ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 parse_roi, refuse_view, strict_option, threads_option)
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
@@ -22,6 +22,7 @@ def report(
     activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
     force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
+    stream: Optional[int] = stream_option(),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
@@ -51,6 +52,9 @@ def report(
       wallcli report clip.mp4 --roi 100,50,640,360 -o clip.html --force
       wallcli scan cam1/*.mp4 -o results.jsonl && wallcli report results.jsonl -o index.html
     """
+    from wallcli.cli.common import use_stream
+
+    use_stream(stream)
     from wallcli.errors import UsageError
 
     if output.suffix.lower() not in (".html", ".htm"):

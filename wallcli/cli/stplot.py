@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
@@ -26,6 +26,7 @@ def stplot(
     json_out: bool = typer.Option(False, "--json", help="Print a metadata summary as JSON on stdout."),
     force: bool = typer.Option(False, "--force", help=force_help("the -o and --png files")),
     threads: int = threads_option(THREADS_HELP),
+    stream: Optional[int] = stream_option(),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
     64 positions x time x RGB) and over columns (vertical plot).
@@ -40,6 +41,9 @@ def stplot(
       wallcli stplot clip.mp4 --roi 100,50,640,360 --png wall.png --style diverging
       ffmpeg -i rtsp://cam/stream -f nut - | wallcli stplot - --mean ema -o live.npz
     """
+    from wallcli.cli.common import use_stream
+
+    use_stream(stream)
     from wallcli.errors import UsageError
 
     if output is None and png is None and not json_out:

@@ -17,6 +17,7 @@ import queue
 import re
 import threading
 import warnings
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -202,6 +203,44 @@ def frame_planes(frame) -> Planes:
     return Planes(y, u, v, kind="yuv", sub_x=sx, sub_y=sy, depth=bits, matrix=spc, full_range=full)
 
 
+def rotate_planes(planes: Planes, k: int) -> Planes:
+    """``planes`` turned by k quarter turns counterclockwise (np.rot90's sense), each plane copied
+    to contiguous memory; a quarter turn swaps the chroma's horizontal and vertical subsampling."""
+    k %= 4
+    if not k:
+        return planes
+
+    def turn(a):
+        return None if a is None else np.ascontiguousarray(np.rot90(a, k))
+
+    sx, sy = (planes.sub_y, planes.sub_x) if k % 2 else (planes.sub_x, planes.sub_y)
+    return Planes(turn(planes.y), turn(planes.u), turn(planes.v), kind=planes.kind, sub_x=sx, sub_y=sy,
+                  depth=planes.depth, matrix=planes.matrix, full_range=planes.full_range)
+
+
+def quarter_turns(rotation) -> int | None:
+    """np.rot90's k that shows a frame as its display matrix asks (FFmpeg's ``rotation``: degrees
+    the matrix turns the frame counterclockwise); None for an angle that is not a quarter turn."""
+    angle = float(rotation or 0.0)
+    k = round(angle / 90.0)
+    return k % 4 if abs(angle - 90.0 * k) < 1.0 else None
+
+
+# The video stream to read (its index in the file, as ffprobe numbers them), for commands given
+# --stream N (cli.common.use_stream); None: the first real video stream
+STREAM: ContextVar[int | None] = ContextVar("wallcli_stream", default=None)
+
+
+def _real_video(stream) -> bool:
+    """A stream of moving pictures that FFmpeg can decode, not a cover picture or a thumbnail track."""
+    d = getattr(stream, "disposition", None)
+    try:
+        still = bool(d & (d.__class__.attached_pic | d.__class__.timed_thumbnails | d.__class__.still_image))
+    except (AttributeError, TypeError):
+        still = False
+    return not still and stream.codec_context is not None
+
+
 def _describe_open_error(source: str, exc: Exception) -> WallcliError:
     text = str(exc)
     if isinstance(exc, FileNotFoundError) or "No such file" in text:
@@ -218,7 +257,8 @@ def _is_url(source: str) -> bool:
 class VideoReader:
     """Open with :func:`open_video`; iterate :meth:`frames` once (decode once, stream)."""
 
-    def __init__(self, source: str, *, threads: int = 0, input_format: str | None = None):
+    def __init__(self, source: str, *, threads: int = 0, input_format: str | None = None,
+                 stream_index: int | None = None):
         import av
 
         self.source = source
@@ -251,10 +291,11 @@ class VideoReader:
         if not self._container.streams.video:
             self._container.close()
             raise WallcliError(f"{source} has no video stream")
-        stream = self._container.streams.video[0]
-        if stream.codec_context is None:  # a codec FFmpeg has no decoder for (or a damaged header naming one)
+        try:
+            stream = self._pick_stream(source, STREAM.get() if stream_index is None else stream_index)
+        except WallcliError:
             self._container.close()
-            raise WallcliError(f"{source}: FFmpeg cannot decode its video codec")
+            raise
         stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
         stream.codec_context.thread_count = int(threads)
         self._stream = stream
@@ -289,9 +330,69 @@ class VideoReader:
             codec=str(cc.name or ""),
             container=str(self._container.format.name or ""),
         )
+        self.rotation = 0  # quarter turns (np.rot90's k) applied to every frame: its display matrix
+        self._rotation_noted = False
+        self._peek_rotation(target, fmt, options)
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs
         self.gaps: list[tuple[float, float]] = []  # (time of the frame before, time of the frame after) per jump
+
+    def _pick_stream(self, source: str, index: int | None):
+        """The video stream to read: ``index`` (--stream N) or the first real one; a file with
+        several says which was taken."""
+        videos = list(self._container.streams.video)
+        if index is not None:
+            chosen = [s for s in videos if s.index == index]
+            if not chosen:
+                names = ", ".join(str(s.index) for s in videos)
+                raise WallcliError(f"{source} has no video stream {index} (its video streams: {names})")
+            stream = chosen[0]
+        else:
+            real = [s for s in videos if _real_video(s)]
+            stream = real[0] if real else videos[0]
+            if len(videos) > 1:
+                self.warnings.append(f"{source} has {len(videos)} video streams; reading stream {stream.index} "
+                                     f"({stream.codec_context.name if stream.codec_context else '?'}, "
+                                     f"{stream.codec_context.width if stream.codec_context else '?'}x"
+                                     f"{stream.codec_context.height if stream.codec_context else '?'}); "
+                                     "--stream N reads another")
+                warnings.warn(self.warnings[-1], VideoWarning, stacklevel=3)
+        if stream.codec_context is None:  # a codec FFmpeg has no decoder for (or a damaged header naming one)
+            raise WallcliError(f"{source}: FFmpeg cannot decode its video codec")
+        return stream
+
+    def _peek_rotation(self, target: str, fmt, options) -> None:
+        """A file's display rotation (its first frame's display matrix), known before the frames
+        are read so that the announced size is the size shown. Streams and URLs are not read twice:
+        their frames are turned as they come, and the size is the decoded frame's (as everywhere)."""
+        if target != self.source or _is_url(self.source) or self.source.startswith("/dev/"):
+            return
+        import av
+
+        try:
+            with av.open(target, mode="r", format=fmt, options=options, timeout=30.0) as c:
+                s = c.streams[self._stream.index]
+                for frame in c.decode(s):
+                    k = quarter_turns(frame.rotation)
+                    self.rotation = k or 0
+                    if k and k % 2:
+                        self.info.width, self.info.height = self.info.height, self.info.width
+                    break
+        except (av.error.FFmpegError, OSError, ValueError, IndexError):
+            pass  # the real read reports what is wrong
+
+    def _turn(self, frame, planes: Planes) -> Planes:
+        k = quarter_turns(getattr(frame, "rotation", 0))
+        if k is None:
+            if not self._rotation_noted:
+                self._rotation_noted = True
+                self._warn(f"{self.source}: a display rotation of {-float(frame.rotation):g} degrees is not applied "
+                           "(only quarter turns are); frames are read as stored")
+            return planes
+        if k and not self._rotation_noted:
+            self._rotation_noted = True
+            self.warnings.append(f"{self.source}: display rotation of {(-90 * k) % 360} degrees applied")
+        return rotate_planes(planes, k)
 
     # -- decoding -------------------------------------------------------------------------------
     def _decode_into(self, q: "queue.Queue", stop: threading.Event) -> None:
@@ -364,7 +465,7 @@ class VideoReader:
                         else:
                             recent.append(dt)
                     last_time = t
-                    yield Frame(index, t, frame_planes(frame), frame, gap)
+                    yield Frame(index, t, self._turn(frame, frame_planes(frame)), frame, gap)
                     index += 1
                 elif kind == "damage":
                     self._warn(f"{self.source}: the stream is damaged after frame {index} ({item}); "
@@ -456,6 +557,9 @@ class VideoWarning(UserWarning):
     """Recoverable trouble in a video (corrupt packets, truncation); the CLI prints these once."""
 
 
-def open_video(source: str | os.PathLike, *, threads: int = 0, input_format: str | None = None) -> VideoReader:
-    """Open a path, an http(s)/rtsp URL, '-' (a streamable container on stdin) or /dev/videoN."""
-    return VideoReader(str(source), threads=threads, input_format=input_format)
+def open_video(source: str | os.PathLike, *, threads: int = 0, input_format: str | None = None,
+               stream: int | None = None) -> VideoReader:
+    """Open a path, an http(s)/rtsp URL, '-' (a streamable container on stdin) or /dev/videoN.
+    ``stream``: the video stream's index in the file (default: :data:`STREAM`, else the first
+    real video stream)."""
+    return VideoReader(str(source), threads=threads, input_format=input_format, stream_index=stream)
