@@ -365,8 +365,8 @@ class VideoReader:
         """A file's display rotation (its first frame's display matrix), known before the frames
         are read so that the announced size is the size shown. Streams and URLs are not read twice:
         their frames are turned as they come, and the size is the decoded frame's (as everywhere)."""
-        if target != self.source or _is_url(self.source) or self.source.startswith("/dev/"):
-            return
+        if target != self.source or _is_url(self.source) or not os.path.isfile(self.source):
+            return  # (a pipe or a device read twice would lose what the first read took)
         import av
 
         try:
