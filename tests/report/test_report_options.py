@@ -69,3 +69,17 @@ def test_strict_on_scan_results(results, tmp_path, run_cli):
 def test_corrections_options_are_refused_on_scan_results(results, tmp_path, run_cli):
     code, _, err = run_cli("report", results, "-o", tmp_path / "i.html", "--no-shake")
     assert code == 2 and "--no-shake" in err
+
+
+def test_the_command_line_carries_the_stream(tmp_path):
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parents[1]))
+    from test_video import _two_streams
+
+    clip = _two_streams(tmp_path)
+    out = tmp_path / "r.html"
+    assert run_main("report", clip, "-o", out, "--stream", "1") == 0
+    facts = _facts(parse(out.read_text(encoding="utf-8")))
+    assert "--stream 1" in facts["Command"] and facts["Resolution"] == "64 × 48 pixels"

@@ -61,8 +61,9 @@ def report(
         raise UsageError(f"-o must end in .html (got {output})")
     roi_t = parse_roi(roi)
     results = str(input).lower().endswith(RESULTS_SUFFIXES)
-    if results and (roi_t or count_model or activity_model or no_deflicker or no_exposure or no_shake):
-        raise UsageError("--roi, --count-model, --activity-model and --no-deflicker/--no-exposure/--no-shake apply "
+    if results and (roi_t or count_model or activity_model or no_deflicker or no_exposure or no_shake
+                    or stream is not None):
+        raise UsageError("--roi, --count-model, --activity-model, --stream and --no-deflicker/--no-exposure/--no-shake apply "
                          "to a video; scan results are already analysed (scan records its options in each line)")
 
     from wallcli.cli.output import progress, warn
@@ -73,7 +74,8 @@ def report(
     check_outputs([output], force=force, inputs=[input, count_model or shipped_model_path("count"),
                                                  activity_model or shipped_model_path("activity")])
     command = _command_line(input, output, roi, count_model, activity_model, force, threads,
-                            strict=strict, no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake)
+                            strict=strict, no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake,
+                            stream=stream)
     if results:
         from wallcli.report.pages import scan_page
         from wallcli.report.scan import read_results, summarise
@@ -114,12 +116,13 @@ def report(
 
 
 def _command_line(input, output, roi, count_model, activity_model, force, threads, *, strict=False,
-                  no_deflicker=False, no_exposure=False, no_shake=False) -> str:
+                  no_deflicker=False, no_exposure=False, no_shake=False, stream=None) -> str:
     """The command as given, in canonical form (options in a fixed order; the same in-process):
     every option that changes an answer (or the exit status) is in it, so running it again gives
     this page's answers."""
     args = ["wallcli", "report", str(input), "-o", str(output)]
-    for flag, value in (("--roi", roi), ("--count-model", count_model), ("--activity-model", activity_model)):
+    for flag, value in (("--roi", roi), ("--count-model", count_model), ("--activity-model", activity_model),
+                        ("--stream", stream)):
         if value is not None:
             args += [flag, str(value)]
     for flag, on in (("--no-deflicker", no_deflicker), ("--no-exposure", no_exposure), ("--no-shake", no_shake),
