@@ -305,7 +305,10 @@ class VideoReader:
             self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
         fps = Fraction(rate).limit_denominator(1001)
         try:
-            check_rate(fps, source)
+            # the measured rate only: a container that gives none leaves FFmpeg guessing from its time
+            # base (Matroska's 1000), which says nothing of the frames
+            if stream.average_rate:
+                check_rate(fps, source)
         except WallcliError:
             self._container.close()
             raise
