@@ -25,6 +25,7 @@ from wallcli.errors import UsageError, WallcliError
 
 TASKS = ("count", "activity")
 HEATMAP_CELLS = 48  # cells along the long side, as `wallcli snr --heatmap`
+PLOT_COLUMNS = 2048  # time columns of the plots drawn (PlotThumbnail): more than the figure's pixels
 
 
 @dataclass
@@ -133,7 +134,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         raise UsageError("the count and activity models read plots at different frame rates; a report reads one")
     options = corrections if corrections is not None else Options()
     facts = file_facts(source)
-    thumb = PlotThumbnail()
+    thumb = PlotThumbnail(PLOT_COLUMNS)
     with warnings.catch_warnings(record=True) as caught, open_video(source, threads=threads) as reader:
         warnings.simplefilter("always")
         info = reader.info
