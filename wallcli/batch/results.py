@@ -180,7 +180,8 @@ def _read_csv(path: Path, text: str, columns: list[str]) -> tuple[list[Entry], b
             torn = True
     if rows:
         if rows[0][1] != columns:
-            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
+            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows, or "
+                               "an older wallcli?)",
                                hint="use the same options, another -o, or --force to start it again")
         rows = rows[1:]
     entries = []
