@@ -333,3 +333,10 @@ def test_a_cover_picture_is_not_the_video():
 
     assert not _real_video(Stream(av.stream.Disposition.attached_pic))
     assert _real_video(Stream(av.stream.Disposition.default))
+
+
+def test_stream_does_not_outlive_its_command(tmp_path, run_cli):
+    clip = _two_streams(tmp_path)
+    assert run_cli("snr", clip, "--stream", "1")[0] == 0
+    with open_video(clip) as r:  # a library caller after the command: the default stream
+        assert r.info.width == 16
