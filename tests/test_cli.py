@@ -74,3 +74,30 @@ def test_help_fits_80_columns(run_cli, name, monkeypatch):
     assert code == 0
     long = [line for line in out.splitlines() if len(line) > 80]
     assert not long, long
+
+
+@pytest.mark.parametrize("n,fps", [(2, 30), (100, 25)])
+def test_too_short_quotes_the_files_own_frames(tmp_path, run_cli, n, fps):
+    """Issue 38 item 10: count quoted its resampled samples (1 where snr said 2 decoded)."""
+    import json
+    import re
+
+    import numpy as np
+    from clips import write_clip
+
+    clip = write_clip(tmp_path / "s.mkv", lambda i: np.full((32, 32, 3), 100.0) + i % 3, n, fps=fps,
+                      codec="ffv1", pix_fmt="yuv444p", options={})
+    code, _, err = run_cli("count", clip)
+    assert code == 1 and f"{n} frame(s) decoded" in err, err
+    code, _, err = run_cli("count", clip, "--follow")
+    assert code == 1 and f"{n} frame(s) decoded" in err, err
+    if n >= 3:
+        code, out, _ = run_cli("snr", clip, "--json")
+        assert code == 0 and json.loads(out)["frames"] == n
+    else:
+        code, _, err = run_cli("snr", clip)
+        assert code == 1 and re.search(rf"\b{n} frame\(s\) decoded", err)
+    code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz")
+    if code == 0:
+        code, _, err = run_cli("count", tmp_path / "p.npz")
+        assert code == 1 and f"{n} frame(s) decoded" in err, err

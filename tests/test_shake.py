@@ -186,3 +186,25 @@ def test_shake_sums_give_the_regressed_series_sums_exactly():
     want = (c2.sum(0), (c2 ** 2).sum(0), (d2 ** 2).sum(0), d2.sum(0))
     for g, w in zip(got, want):
         np.testing.assert_allclose(g, w, rtol=1e-6, atol=1e-6)
+
+
+def test_shake_is_corrected_in_answers_read_from_a_plot(tmp_path, run_cli):
+    """Issue 38 item 3: stplot keeps each frame's measured shift in the .npz, so count read from the
+    plot regresses the shake out as count read from the video does."""
+    from wallcli.sim.views import encode
+
+    frames, _ = _frames(5, 0.5)
+    path = encode((np.repeat(f[:, :, None], 3, axis=2) for f in frames), tmp_path / "shaking.mp4", fps=30.0, crf=0)
+    npz = tmp_path / "p.npz"
+    code, _, err = run_cli("stplot", path, "-o", npz)
+    assert code == 0, err
+    code, out, err = run_cli("count", npz, "--json")
+    assert code == 0, err
+    from_plot = json.loads(out)
+    code, out, err = run_cli("count", path, "--json")
+    from_video = json.loads(out)
+    kinds = [c["kind"] for c in from_plot["corrections"]]
+    assert "shake" in kinds and kinds == [c["kind"] for c in from_video["corrections"]]
+    assert from_plot["label"] == from_video["label"]
+    code, out, err = run_cli("count", npz, "--json", "--no-shake")
+    assert code == 0 and "shake" not in [c["kind"] for c in json.loads(out)["corrections"]]

@@ -4,12 +4,14 @@ import subprocess
 import sys
 import warnings
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from clips import write_clip
 from wallcli.errors import WallcliError
+import wallcli.io.video as video
 from wallcli.io.video import open_video
 from wallcli.signal.blocks import rgb_grid
 
@@ -205,3 +207,154 @@ def test_repeatable_writer_gives_the_same_h264_file_every_time(tmp_path):
                 w.write(f)
         files.append(out.read_bytes())
     assert all(f == files[0] for f in files[1:])
+
+
+@pytest.mark.parametrize("fps", [Fraction(1, 2), Fraction(500)])
+def test_a_frame_rate_outside_what_wallcli_reads_is_refused_alike_everywhere(tmp_path, run_cli, fps):
+    """Issue 38 item 5: a 0.5 fps file gave count eight windows and 32 dB, snr -99 dB."""
+    clip = write_clip(tmp_path / "slow.mkv", lambda i: np.full((32, 32, 3), 100.0) + i % 5, 12, fps=fps,
+                      codec="ffv1", pix_fmt="yuv444p", options={})
+    lines = set()
+    for args in (["count"], ["activity"], ["snr"], ["stplot", "-o", tmp_path / "p.npz"],
+                 ["amplify", tmp_path / "a.mp4"], ["report", "-o", tmp_path / "r.html"]):
+        code, out, err = run_cli(args[0], clip, *args[1:])
+        assert code == 1 and out == "" and err.count("\n") == 1 and "fps" in err, (args, err)
+        lines.add(err)
+    assert len(lines) == 1  # word for word the same line
+
+
+def _gappy(tmp_path, lost=70, n=290):
+    """A wall clip at 30 fps whose frames 90 to 90 + lost are gone: the timestamps jump."""
+    def frame(i):
+        return np.full((48, 64, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (48, 64, 3))
+
+    return write_clip(tmp_path / "gap.mp4", frame, n, fps=30, pts_fn=lambda i: i if i < 90 else i + lost,
+                      time_base=Fraction(1, 30))
+
+
+def test_a_jump_of_the_timestamps_is_a_gap(tmp_path):
+    clip = _gappy(tmp_path)
+    with video.open_video(clip) as r:
+        with pytest.warns(video.VideoWarning, match="frames missing"):
+            frames = [(f.time, f.gap) for f in r.frames()]
+        assert r.gaps == [(pytest.approx(89 / 30, abs=1e-3), pytest.approx(160 / 30, abs=1e-3))]
+    assert [g for _, g in frames if g] == [pytest.approx(71 / 30, abs=1e-3)]
+    # a whole clip without lost frames has none
+    write_clip(tmp_path / "ok.mp4", lambda i: np.full((16, 16, 3), 100.0), 40, fps=30)
+    with video.open_video(tmp_path / "ok.mp4") as r:
+        assert not any(f.gap for f in r.frames()) and r.gaps == []
+
+
+def test_windows_across_a_gap_are_not_relied_upon_and_the_json_lists_it(tmp_path, run_cli):
+    """Issue 38 item 4: 2.4 s of lost frames changed count 1 -> 2 with only a corrupt-packet note."""
+    import json
+
+    clip = _gappy(tmp_path)
+    code, out, err = run_cli("count", clip, "--json")
+    assert code == 0 and "frames missing" in err
+    res = json.loads(out)
+    assert "frame gap" in res["view"]["issues"] and res["confident"] is False
+    assert "frames missing at 3.0-5.3 s" in res["reason"]
+    for w in res["windows"]:
+        crosses = w["start"] <= 160 / 30 and w["end"] >= 89 / 30
+        assert (w["confident"] is False and "frame gap" in w["view"]["issues"]) if crosses else True
+    code, out, err = run_cli("snr", clip, "--json")
+    snr = json.loads(out)
+    assert code == 0 and any("frames missing" in w for w in snr["warnings"])  # (stderr: once a process)
+    assert snr["view"]["gaps"] == [[pytest.approx(89 / 30, abs=1e-3), pytest.approx(160 / 30, abs=1e-3)]]
+    code, _, err = run_cli("count", clip, "--strict")
+    assert code == 1 and "frames missing" in err
+
+
+def _rotated(tmp_path) -> Path:
+    """A wall whose stored left half is bright, with a display matrix turning it 90 degrees
+    clockwise (as phones write portrait video): shown, the bright half is on top."""
+    import struct
+
+    def frame(i):
+        img = np.full((48, 64, 3), 60.0)
+        img[:, :32] = 180.0
+        return img + np.random.default_rng(i).normal(0, 1, img.shape)
+
+    p = write_clip(tmp_path / "stored.mp4", frame, 30, fps=30)
+    data = bytearray(p.read_bytes())
+    i = data.find(b"tkhd") + 4
+    off = i + (40 if data[i] == 0 else 52)  # the matrix, after the header's times, ids and volume
+    data[off:off + 36] = struct.pack(">9i", 0, 0x10000, 0, -0x10000, 0, 0, 0, 0, 0x40000000)
+    out = tmp_path / "rot90.mp4"
+    out.write_bytes(bytes(data))
+    return out
+
+
+def test_display_rotation_is_honoured(tmp_path, run_cli):
+    """Issue 38 item 6: a 90 degree display matrix was ignored (the plots ran along the wrong axis)."""
+    import json
+
+    clip = _rotated(tmp_path)
+    with open_video(clip) as r:
+        assert (r.info.width, r.info.height) == (48, 64)
+        planes = next(iter(r.frames())).planes
+        assert planes.y.shape == (64, 48) and planes.u.shape == (32, 24)
+        assert planes.y[:30].mean() > planes.y[34:].mean() + 50  # bright on top, as shown
+        assert any("rotation of 90 degrees applied" in w for w in r.warnings)
+    code, out, err = run_cli("snr", clip, "--json")
+    assert code == 0, err
+    assert json.loads(out)["roi"] == [0, 0, 48, 64]
+    code, out, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz", "--json")
+    assert code == 0 and json.loads(out)["frame_size"] == [48, 64]
+    v = np.load(tmp_path / "p.npz")["v_mean"][:, 1]  # top to bottom along the shown frame
+    assert v[:24].mean() > v[40:].mean() + 50
+
+
+def _two_streams(tmp_path) -> Path:
+    import av
+
+    path = tmp_path / "two.mkv"
+    with av.open(str(path), "w") as c:
+        a = c.add_stream("ffv1", rate=30)
+        a.width, a.height, a.pix_fmt = 16, 16, "yuv444p"
+        b = c.add_stream("ffv1", rate=30)
+        b.width, b.height, b.pix_fmt = 64, 48, "yuv444p"
+        for i in range(12):
+            for s, (h, w) in ((a, (16, 16)), (b, (48, 64))):
+                for p in s.encode(av.VideoFrame.from_ndarray(np.full((h, w, 3), 100 + i, np.uint8), format="rgb24")):
+                    c.mux(p)
+        for s in (a, b):
+            for p in s.encode():
+                c.mux(p)
+    return path
+
+
+def test_several_video_streams_say_which_and_stream_picks(tmp_path, run_cli):
+    import json
+
+    clip = _two_streams(tmp_path)
+    code, out, err = run_cli("snr", clip, "--json")
+    assert code == 0 and json.loads(out)["roi"] == [0, 0, 16, 16]
+    assert "2 video streams; reading stream 0" in err and "--stream" in err
+    code, out, err = run_cli("snr", clip, "--json", "--stream", "1")
+    assert code == 0 and json.loads(out)["roi"] == [0, 0, 64, 48] and "video streams" not in err
+    code, out, err = run_cli("snr", clip, "--json")  # the choice does not outlive its command
+    assert code == 0 and json.loads(out)["roi"] == [0, 0, 16, 16]
+    code, _, err = run_cli("stplot", clip, "--json", "--stream", "5")
+    assert code == 1 and "no video stream 5" in err and "0, 1" in err
+
+
+def test_a_cover_picture_is_not_the_video():
+    import av
+
+    from wallcli.io.video import _real_video
+
+    class Stream:
+        def __init__(self, disposition):
+            self.disposition, self.codec_context = disposition, object()
+
+    assert not _real_video(Stream(av.stream.Disposition.attached_pic))
+    assert _real_video(Stream(av.stream.Disposition.default))
+
+
+def test_stream_does_not_outlive_its_command(tmp_path, run_cli):
+    clip = _two_streams(tmp_path)
+    assert run_cli("snr", clip, "--stream", "1")[0] == 0
+    with open_video(clip) as r:  # a library caller after the command: the default stream
+        assert r.info.width == 16

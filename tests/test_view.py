@@ -235,3 +235,49 @@ def test_a_cut_between_alike_views_is_a_scene_cut(tmp_path):
     b = [np.clip(np.rint(f * shade), 0, 255).astype(np.uint8) for f in a]
     view = _check(_encode(tmp_path / "c.mp4", views.cut(a, b, np.random.default_rng(3), n=N)))
     assert view["issues"] == ["scene cut"], view
+
+
+@pytest.mark.parametrize("w,h", [(4000, 16), (1, 1000)])
+def test_a_frame_too_thin_to_register_is_a_view_issue_not_a_crash(tmp_path, run_cli, w, h):
+    """Issue 38 item 9: OpenCV's createHanningWindow needs two samples each way; the check's
+    image of these is one sample thin. An answer, with the view issue; the report is drawn."""
+    def frame(i):
+        return np.full((h, w, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (h, w, 3))
+
+    clip = write_clip(tmp_path / "thin.nut", frame, 12, fps=30, codec="rawvideo", pix_fmt="yuv444p", options={})
+    code, out, err = run_cli("snr", clip, "--json")
+    assert code == 0, err
+    view = json.loads(out)["view"]
+    assert view["usable"] is False and view["issues"] == ["too thin to check"]
+    code, _, err = run_cli("snr", clip, "--json", "--strict")
+    assert code == 1 and "too thin" in err and "internal error" not in err
+
+
+def test_a_one_pixel_wide_clip_gets_its_report(tmp_path, run_cli):
+    """The report's pictures are drawn at a bounded aspect (a 1x1000 frame to scale ran out of memory)."""
+    def frame(i):
+        return np.full((1000, 1, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (1000, 1, 3))
+
+    clip = write_clip(tmp_path / "thin.nut", frame, 12, fps=30, codec="rawvideo", pix_fmt="yuv444p", options={})
+    code, _, err = run_cli("report", clip, "-o", tmp_path / "r.html")
+    assert code == 0 and "internal error" not in err, err
+
+
+def test_answers_from_a_plot_carry_the_videos_view(run_cli, crossing, tmp_path):
+    """Issue 38 item 3: stplot keeps the view verdict in the .npz; count/activity read from it carry
+    it (windows and clip), and --strict refuses it, as from the video."""
+    npz = tmp_path / "p.npz"
+    code, out, err = run_cli("stplot", crossing, "-o", npz, "--json")
+    assert code == 0, err
+    assert json.loads(out)["view"]["usable"] is False
+    code, out, _ = run_cli("count", crossing, "--json")
+    from_video = json.loads(out)
+    code, out, err = run_cli("count", npz, "--json")
+    assert code == 0, err
+    r = json.loads(out)
+    assert r["view"]["usable"] is False and r["view"]["issues"] == from_video["view"]["issues"]
+    assert r["confident"] is False and r["reason"] == from_video["view"]["reason"]
+    assert [w["view"]["usable"] for w in r["windows"]] == [w["view"]["usable"] for w in from_video["windows"]]
+    for cmd in ("count", "activity"):
+        code, out, err = run_cli(cmd, npz, "--strict")
+        assert code == 1 and out == "" and "moving object" in err

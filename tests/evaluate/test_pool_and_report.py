@@ -59,3 +59,23 @@ def test_the_table_marks_undetermined_answers_and_names_failures(capsys):
     assert "b.mp4 1 0 ? " in out and "[1]" not in out  # the answer with '?', no footnote
     assert "c.mp4 0 error" in out and "1 clip failed: no such file: c.mp4" in out
     assert "right 1 (33.3 %)" in out and "decided 1 (33 %)" in out  # right; decided (coverage)
+
+
+def test_bootstrap_memory_does_not_grow_with_the_clips():
+    """Issue 38 item 7: 100 000 rows (missing clips count as wrong) once took resamples x rows."""
+    import tracemalloc
+
+    import numpy as np
+
+    from wallcli.evaluate.score import bootstrap_ci
+
+    hits = np.zeros(100_000, bool)
+    hits[:30_000] = True
+    tracemalloc.start()
+    lo, hi = bootstrap_ci(hits, n=500)  # the old way: 500 x 100 000 indices, 400 MB
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 20e6 and lo < 0.3 < hi and hi - lo < 0.01
+    # and the interval is the resampling one: 3 of 4 right
+    lo, hi = bootstrap_ci(np.array([1, 1, 1, 0], bool))
+    assert lo == 0.25 and hi == 1.0

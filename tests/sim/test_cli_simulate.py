@@ -66,3 +66,16 @@ def test_simulated_h264_does_not_depend_on_the_number_of_cores(tmp_path):
                    capture_output=True)
     subprocess.run([*args, "-o", str(all_)], check=True, capture_output=True)
     assert one.read_bytes() == all_.read_bytes()
+
+
+@pytest.mark.parametrize("suffix", [".mkv", ".y4m"])
+def test_crf_is_refused_where_it_would_not_apply(tmp_path, run_cli, suffix):
+    """Issue 38 item 11: .mkv is lossless FFV1 whatever --crf said (and the sidecar said crf 30)."""
+    out = tmp_path / f"x{suffix}"
+    code, _, err = run_cli("simulate", "-o", out, "--crf", "30", "--size", "32x32", "--duration", "0.4",
+                           "--fps", "15", "--grid", "4x4")
+    assert code == 2 and "--crf" in err and suffix in err
+    assert list(tmp_path.iterdir()) == []
+    code, _, err = run_cli("simulate", "-o", out, "--size", "32x32", "--duration", "0.4", "--fps", "15",
+                           "--grid", "4x4")
+    assert code == 0, err

@@ -88,7 +88,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     out: dict[str, Any] = {"frames": state["frames"], "duration": round(state["last"] + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes, "view": check.summary()}
     for task, c in zip(classify, classifiers):
-        out[task] = with_view(c.result(source), check)
+        out[task] = with_view(c.result(source, frames=state["frames"]), check)
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
     out["corrections"] = next((out[t]["corrections"] for t in TASKS if t in out), [])

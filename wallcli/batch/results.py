@@ -5,9 +5,10 @@ lock (``flock``) on it from before it reads it until it ends, and a second scan 
 stops at once, saying so (two writers would both append every video). Every finished video's line is written, flushed and fsynced
 before the next one is, so a crash, Ctrl-C or ``kill -9`` leaves every finished line intact and
 at most one torn last line, which the next run drops. On that next run, lines of videos that are
-unchanged (same sha256) and scanned for the same tasks are kept and their videos skipped;
-errors and videos that changed are done again and their old lines dropped, so each video keeps
-exactly one line.
+unchanged (same sha256), scanned for the same tasks, with the same options (each line records them
+under "options") and the same models are kept and their videos skipped; errors, videos that
+changed and lines made with other options or models are done again and their old lines dropped,
+so each video keeps exactly one line.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from typing import Any, Callable
 from wallcli.errors import WallcliError
 from wallcli.io.text import escape_surrogates, unescape_surrogates
 
-BASE = ["input", "size", "sha256", "duration", "frames", "tasks", "seconds", "error", "warnings"]
+BASE = ["input", "size", "sha256", "duration", "frames", "tasks", "options", "seconds", "error", "warnings"]
 CHANNELS = ("r", "g", "b")
 
 
@@ -112,6 +113,14 @@ class Entry:
     sha256: str | None
     tasks: tuple[str, ...]
     error: str | None
+    options: dict | None = None  # the options that made it (ScanConfig.options); None: not recorded
+    models: dict | None = None  # task -> sha256 of the model that answered it
+    view: dict | None = None  # the clip's view verdict (--strict reads it on a resume)
+
+
+def _models(d: dict) -> dict:
+    return {t: (d.get(t) or {}).get("model", {}).get("sha256") for t in ("count", "activity")
+            if isinstance(d.get(t), dict) and isinstance(d[t].get("model"), dict)}
 
 
 def _entry_json(raw: str) -> Entry | None:
@@ -121,7 +130,10 @@ def _entry_json(raw: str) -> Entry | None:
         return None
     if not isinstance(d, dict) or not isinstance(d.get("input"), str) or not isinstance(d.get("tasks"), list):
         return None
-    return Entry(raw, d["input"], d.get("size"), d.get("sha256"), tuple(d["tasks"]), d.get("error"))
+    options = d.get("options") if isinstance(d.get("options"), dict) else None
+    view = d.get("view") if isinstance(d.get("view"), dict) else None
+    return Entry(raw, d["input"], d.get("size"), d.get("sha256"), tuple(d["tasks"]), d.get("error"), options,
+                 _models(d), view)
 
 
 def _entry_csv(row: list[str], header: list[str]) -> Entry | None:
@@ -132,8 +144,17 @@ def _entry_csv(row: list[str], header: list[str]) -> Entry | None:
         size = int(d["size"]) if d["size"] else None
     except ValueError:
         return None
+    try:
+        options = json.loads(d["options"]) if d.get("options") else None
+    except json.JSONDecodeError:
+        options = None
+    models = {t: d[f"{t}.model.sha256"] for t in ("count", "activity") if d.get(f"{t}.model.sha256")}
+    view = None
+    if d.get("view.usable"):
+        view = {"usable": d["view.usable"] == "true", "reason": d.get("view.reason") or None}
     return Entry(csv_record(row)[:-1], unescape_surrogates(d["input"]), size, d["sha256"] or None,
-                 tuple(t for t in d["tasks"].split(",") if t), d["error"] or None)
+                 tuple(t for t in d["tasks"].split(",") if t), d["error"] or None,
+                 options if isinstance(options, dict) else None, models, view)
 
 
 def _not_ours(path: Path, n: int) -> WallcliError:
@@ -159,7 +180,8 @@ def _read_csv(path: Path, text: str, columns: list[str]) -> tuple[list[Entry], b
             torn = True
     if rows:
         if rows[0][1] != columns:
-            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows?)",
+            raise WallcliError(f"{path} has other columns than this scan writes (another --task or --windows, or "
+                               "an older wallcli?)",
                                hint="use the same options, another -o, or --force to start it again")
         rows = rows[1:]
     entries = []

@@ -41,8 +41,24 @@ def _unchanged(source: str, entry) -> bool:
         return False
 
 
-def plan(sources: list[str], out: Path, tasks, *, force: bool, columns) -> tuple[list[str], int, list | None]:
-    """(videos to do, videos skipped, the earlier lines to keep or None to keep the file as it is)."""
+def same_making(entry, options: dict | None, models: dict | None) -> bool:
+    """Was ``entry``'s line made as this run would make it: the same options (a line that does not
+    record them is from an older wallcli: made again) and, per classification task, the same model?"""
+    if options is not None and entry.options != options:
+        return False
+    if models:
+        return all((entry.models or {}).get(t) == sha for t, sha in models.items())
+    return True
+
+
+def plan(sources: list[str], out: Path, tasks, *, force: bool, columns, options: dict | None = None,
+         models: dict | None = None, stale: list | None = None,
+         skipped: list | None = None) -> tuple[list[str], int, list | None]:
+    """(videos to do, videos skipped, the earlier lines to keep or None to keep the file as it is).
+
+    A line made with other ``options`` or ``models`` ({task: sha256}) is not this run's answer:
+    its video is analysed again and the new line replaces it (``stale`` collects their inputs).
+    ``skipped`` collects the entries of the videos skipped (their lines are this run's answers)."""
     from wallcli.batch.results import key, read
 
     if force:
@@ -58,11 +74,17 @@ def plan(sources: list[str], out: Path, tasks, *, force: bool, columns) -> tuple
     for e in entries:
         k = key(e.input)
         if e.error is None and k in wanted and k not in done and _unchanged(wanted[k], e):
+            if not same_making(e, options, models):
+                if stale is not None:
+                    stale.append(e.input)
+                continue
             done[k] = e
     # this run's videos keep only the lines just found valid; failed or changed ones are done again
     kept = [e for e in entries if key(e.input) not in wanted or done.get(key(e.input)) is e]
     dropped = len(entries) - len(kept)
     todo = [s for s in sources if key(s) not in done]
+    if skipped is not None:
+        skipped.extend(done.values())
     return todo, len(done), (kept if (dropped or torn or header_missing) else None)
 
 
@@ -72,11 +94,13 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
              log: Callable[[str], None] = lambda m: None,
              on_start: Callable[[int, int], None] = lambda todo, skipped: None,
              on_line: Callable[[dict], None] = lambda line: None, debug: bool = False,
+             on_skip: Callable[[list], None] = lambda entries: None,
              deflicker: bool = True, exposure: bool = True, shake: bool = True) -> dict[str, Any]:
     """Scan every video named by ``inputs`` into ``output``; the summary of the run.
 
     ``on_start(todo, skipped)`` once the work is known; ``on_line(line)`` after each line is
-    stored. Exceptions are for the run as a whole (no video, bad output, unreachable cluster,
+    stored; ``on_skip(entries)`` with the :class:`~wallcli.batch.results.Entry` of each video skipped
+    (its earlier line kept as this run's answer). Exceptions are for the run as a whole (no video, bad output, unreachable cluster,
     mismatched workers, interruption); a video's own failure is its error line.
     """
     from wallcli.batch.engine import Engine
@@ -88,7 +112,10 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
     tasks = tuple(t for t in TASKS if t in tasks)
     # the results file inside a scanned folder is not a video: running the command again resumes
     sources = expand_inputs([str(i) for i in inputs], globs, skip=Path(output))
-    out = check_output(output, force=True, inputs=[s for s in sources if not is_url(s)])
+    from wallcli.infer.model import shipped_model_path
+
+    out = check_output(output, force=True, inputs=[*(s for s in sources if not is_url(s)),
+                                                   *(shipped_model_path(t) for t in CLASSIFY if t in tasks)])
     columns = csv_columns(tasks, _classes(tasks), windows) if is_csv(out) else None
     results = ResultsFile(out, encode, columns)
     results.open()  # and locked: from here to the end, no other scan writes it
@@ -96,10 +123,21 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
     seconds_of_video = 0.0
     engine_workers = 0
     try:
-        todo, skipped, kept = plan(sources, out, tasks, force=force, columns=columns)
+        options = ScanConfig(tasks=tasks, windows=windows, deflicker=deflicker, exposure=exposure,
+                             shake=shake).options()
+        models = {t: sha for t, sha in identity()["models"].items() if t in tasks}
+        stale: list = []
+        skipped_entries: list = []
+        todo, skipped, kept = plan(sources, out, tasks, force=force, columns=columns, options=options,
+                                   models=models, stale=stale, skipped=skipped_entries)
         if skipped:
-            log(f"{skipped} of {len(sources)} videos already in {out} (same sha256 and tasks): skipped; "
-                "--force redoes them")
+            log(f"{skipped} of {len(sources)} videos already in {out} (same sha256, tasks, options and models): "
+                "skipped; --force redoes them")
+        if stale:
+            log(f"{len(stale)} video(s) in {out} were analysed with other options or models (e.g. {stale[0]}): "
+                "analysed again, their lines replaced")
+        # this run's answers include the lines it kept: --strict must see their views too
+        on_skip(skipped_entries)
         on_start(len(todo), skipped)
         config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity(),
                             deflicker=deflicker, exposure=exposure, shake=shake)

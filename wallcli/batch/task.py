@@ -31,6 +31,10 @@ class ScanConfig:
     # what the client runs (identity()); a worker that differs answers with an error line
     expected: dict = field(default_factory=dict)
 
+    def options(self) -> dict[str, bool]:
+        """The options that change a line's answers, as the line records them (a resume compares them)."""
+        return {"deflicker": self.deflicker, "exposure": self.exposure, "shake": self.shake, "windows": self.windows}
+
 
 def model_files() -> dict[str, str]:
     """sha256 of each shipped model file, as installed here."""
@@ -143,7 +147,7 @@ def scan_video(source: str, config: ScanConfig) -> dict[str, Any]:
     warnings.simplefilter("ignore", VideoWarning)
     t0 = time.perf_counter()
     line: dict[str, Any] = {"input": source, "size": None, "sha256": None, "duration": None, "frames": None,
-                            "tasks": list(config.tasks)}
+                            "tasks": list(config.tasks), "options": config.options()}
     try:
         if config.expected and identity() != config.expected:
             raise WallcliError(f"this worker runs {describe(identity())}, the client {describe(config.expected)}")

@@ -40,9 +40,12 @@ NO_SHAKE_OPT = shake_option()
 def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: Optional[Path],
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
-        no_shake: bool = False, activity_model: Optional[Path] = None, single_stage: bool = False) -> None:
+        no_shake: bool = False, stream: Optional[int] = None, activity_model: Optional[Path] = None,
+        single_stage: bool = False) -> None:
+    from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 
+    use_stream(stream)
     roi_t = parse_roi(roi)
     fixes = corrections_of(no_deflicker, no_exposure, no_shake)
     if follow and plot is not None:
@@ -53,10 +56,15 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     from wallcli.cli.output import emit_json, progress
     from wallcli.io.writer import check_outputs, committed_together
 
-    # the model is an input too: --plot over it must not replace it
-    check_outputs([plot], force=force, inputs=[input, model_path, activity_model])
+    from wallcli.infer.model import shipped_model_path
     from wallcli.infer.twostage import load_classifier
 
+    # the models and their cards are inputs too: --plot over any must not replace it (a two-stage
+    # count reads the activity model as well)
+    reads = [input, model_path or shipped_model_path(task)]
+    if task == "count" and not single_stage:
+        reads.append(activity_model or shipped_model_path("activity"))
+    check_outputs([plot], force=force, inputs=reads)
     model = load_classifier(task, model_path, threads=threads, activity_path=activity_model, single=single_stage)
     stride = int(stride or model.card["stride"])
 

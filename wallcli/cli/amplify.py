@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # Frames held back while the automatic gain calibrates are kept whole only with --side-by-side
@@ -58,6 +58,7 @@ def amplify(
     json_out: bool = typer.Option(False, "--json", help="Print a summary (gain, frames, fps, size) as JSON on stdout."),
     force: bool = typer.Option(False, "--force", help=force_help("OUTPUT")),
     threads: int = threads_option(THREADS_HELP),
+    stream: Optional[int] = stream_option(),
 ) -> None:
     """Make the invisible visible: a video of the wall's tiny light changes, amplified.
 
@@ -72,6 +73,9 @@ def amplify(
       wallcli amplify clip.mp4 amp.mp4 --side-by-side --scale 0.5 --smooth 0.1
       wallcli amplify clip.mp4 amp.mp4 --roi 100,50,640,360 --gain 200 --cells 32
     """
+    from wallcli.cli.common import use_stream
+
+    use_stream(stream)
     from wallcli.errors import UsageError
 
     if mean not in ("ema", "window"):

@@ -131,8 +131,22 @@ def main(argv: list[str] | None = None) -> None:
     sys.exit(code)
 
 
+def _forget_stream() -> None:
+    """--stream is one command's choice: never the next one's, nor a library caller's after it."""
+    video = sys.modules.get("wallcli.io.video")
+    if video is not None:
+        video.STREAM.set(None)
+
+
 def _run(argv: list[str] | None) -> int:
     """Run the command; print its error line; return the exit code."""
+    try:
+        return _run_command(argv)
+    finally:
+        _forget_stream()
+
+
+def _run_command(argv: list[str] | None) -> int:
     from wallcli.cli.output import StdoutError, abandon_stdout, guarded_stdout, printable
     from wallcli.errors import WallcliError, raise_if_interrupted
 

@@ -115,6 +115,21 @@ def is_npz(path: str) -> bool:
     return str(path).lower().endswith(".npz")
 
 
+def stream_option():
+    """``--stream N``: which video stream of a file with several to read."""
+    return number_option(None, "--stream", lo=0, hi=65535, integer=True,
+                         help="Read the video stream with this index (as ffprobe numbers a file's streams). "
+                              "Default: the first video stream that is not a cover picture; a file with several "
+                              "says which was read.")
+
+
+def use_stream(index) -> None:
+    """Make ``index`` (--stream) the stream every reader of this command opens."""
+    from wallcli.io.video import STREAM
+
+    STREAM.set(index)
+
+
 STRICT_HELP = ("Exit 1 when the view check finds the video is not a static view of a wall (camera motion, "
                "something moving in view, a cut, too little usable area). Without it such answers are "
                "undetermined, with the reason, and the exit status is 0.")

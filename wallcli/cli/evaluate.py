@@ -85,7 +85,13 @@ def evaluate(
     plan = plan_folder(folder, task, min_snr=min_snr)  # fails early (exit 1) on a folder without labels
     for file, why in plan.labels.damaged:
         warn(f"{file} skipped: {why}")
-    check_outputs([plot], force=force, inputs=[model, activity_model, *(c.path for c in plan.labels.clips)])
+    from wallcli.infer.model import shipped_model_path
+
+    # everything read is an input: the models and their cards, the clips, labels.csv or the sidecars
+    models = [model or shipped_model_path(task)]
+    if task == "count" and not single_stage:
+        models.append(activity_model or shipped_model_path("activity"))
+    check_outputs([plot], force=force, inputs=[*models, *(c.path for c in plan.labels.clips), *plan.labels.files])
     # delayed: on a small folder a bar would only flash; on a large one it shows the minutes left
     with progress(f"evaluate {task}", len(plan.kept), delay=PROGRESS_DELAY) as advance:
         result = evaluate_folder(folder, task, model_path=model, roi=roi_t, jobs=jobs, progress=advance, plan=plan,

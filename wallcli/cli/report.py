@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (stream_option, ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 parse_roi, refuse_view, strict_option, threads_option)
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
@@ -22,6 +22,7 @@ def report(
     activity_model: Optional[Path] = typer.Option(None, "--activity-model", help="Your own activity .onnx (its card beside it). Default: the shipped model."),
     force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
+    stream: Optional[int] = stream_option(),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
@@ -52,20 +53,30 @@ def report(
       wallcli scan cam1/*.mp4 -o results.jsonl
       wallcli report results.jsonl -o index.html
     """
+    from wallcli.cli.common import use_stream
+
+    use_stream(stream)
     from wallcli.errors import UsageError
 
     if output.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"-o must end in .html (got {output})")
     roi_t = parse_roi(roi)
     results = str(input).lower().endswith(RESULTS_SUFFIXES)
-    if results and (roi_t or count_model or activity_model):
-        raise UsageError("--roi, --count-model and --activity-model apply to a video; scan results are already analysed")
+    if results and (roi_t or count_model or activity_model or no_deflicker or no_exposure or no_shake
+                    or stream is not None):
+        raise UsageError("--roi, --count-model, --activity-model, --stream and --no-deflicker/--no-exposure/--no-shake apply "
+                         "to a video; scan results are already analysed (scan records its options in each line)")
 
     from wallcli.cli.output import progress, warn
     from wallcli.io.writer import check_outputs, write_text_atomic
 
-    check_outputs([output], force=force, inputs=[input, count_model, activity_model])
-    command = _command_line(input, output, roi, count_model, activity_model, force, threads)
+    from wallcli.infer.model import shipped_model_path
+
+    check_outputs([output], force=force, inputs=[input, count_model or shipped_model_path("count"),
+                                                 activity_model or shipped_model_path("activity")])
+    command = _command_line(input, output, roi, count_model, activity_model, force, threads,
+                            strict=strict, no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake,
+                            stream=stream)
     if results:
         from wallcli.report.pages import scan_page
         from wallcli.report.scan import read_results, summarise
@@ -73,6 +84,13 @@ def report(
         records, problems = read_results(input)
         for p in problems:
             warn(p)
+        if strict:  # as for a video: an unusable view is the input's error, before any page is written
+            bad = [r for r in records if isinstance(r.get("view"), dict) and r["view"].get("usable") is False]
+            if bad:
+                from wallcli.errors import WallcliError
+
+                raise WallcliError(f"{len(bad)} video(s) in {input} not a static view of a wall (--strict), first "
+                                   f"{bad[0].get('input')}: {bad[0]['view'].get('reason') or 'not a static view'}")
         html = scan_page(str(input), summarise(records), problems, command=command)
     else:
         from wallcli.report.analysis import analyse, load_models
@@ -98,12 +116,20 @@ def report(
     wrote((output, f"{what}, {shown}, self-contained: open it in any browser"))
 
 
-def _command_line(input, output, roi, count_model, activity_model, force, threads) -> str:
-    """The command as given, in canonical form (options in a fixed order; the same in-process)."""
+def _command_line(input, output, roi, count_model, activity_model, force, threads, *, strict=False,
+                  no_deflicker=False, no_exposure=False, no_shake=False, stream=None) -> str:
+    """The command as given, in canonical form (options in a fixed order; the same in-process):
+    every option that changes an answer (or the exit status) is in it, so running it again gives
+    this page's answers."""
     args = ["wallcli", "report", str(input), "-o", str(output)]
-    for flag, value in (("--roi", roi), ("--count-model", count_model), ("--activity-model", activity_model)):
+    for flag, value in (("--roi", roi), ("--count-model", count_model), ("--activity-model", activity_model),
+                        ("--stream", stream)):
         if value is not None:
             args += [flag, str(value)]
+    for flag, on in (("--no-deflicker", no_deflicker), ("--no-exposure", no_exposure), ("--no-shake", no_shake),
+                     ("--strict", strict)):
+        if on:
+            args.append(flag)
     if threads:
         args += ["--threads", str(threads)]
     if force:

@@ -49,8 +49,10 @@ def scan(
     is too short, hangs its decoder (--timeout) or kills its worker twice gets a line with
     "error" and the scan goes on.
 
-    Re-running the same command resumes: videos already in the output with the same sha256 and
-    tasks are skipped, failed ones are tried again; --force redoes everything. The exit code is
+    Re-running the same command resumes: videos already in the output with the same sha256,
+    tasks, options (--no-deflicker, --no-exposure, --no-shake, --windows) and models are skipped;
+    failed ones, and ones made with other options or models, are analysed again (the new line
+    replaces the old); --force redoes everything. With --strict, the skipped videos' views count. The exit code is
     0 when every video has its line, failed or not: count failures in the summary (--json).
 
     \b
@@ -86,10 +88,14 @@ def scan(
             log(f"failed: {err}" if line["input"] in err else f"failed: {line['input']}: {err}", wrap=False)
         bar.update(state["hours"], state["failed"])
 
+    def on_skip(entries) -> None:  # a resumed run's kept lines are its answers too (--strict)
+        state["unusable"] += [(e.input, (e.view or {}).get("reason")) for e in entries
+                              if (e.view or {}).get("usable") is False]
+
     with _Bar() as bar:
         summary = run_scan(inputs, output, tasks=tasks, workers=workers, scheduler=scheduler, globs=glob,
                            force=force, windows=windows, timeout=timeout, encode=to_json, log=lambda m: log(m, wrap=False),
-                           on_start=bar.start, on_line=on_line, debug=debug,
+                           on_start=bar.start, on_line=on_line, debug=debug, on_skip=on_skip,
                            deflicker=not no_deflicker, exposure=not no_exposure, shake=not no_shake)
     from wallcli.wording import plural
 
@@ -102,8 +108,9 @@ def scan(
         from wallcli.errors import WallcliError
 
         first, why = state["unusable"][0]
-        raise WallcliError(f"{plural(len(state['unusable']), 'video')} of this run not a static view of a wall "
-                           f"(--strict; every line is written), first {first}: {why}")
+        raise WallcliError(f"{plural(len(state['unusable']), 'video')} of this run (kept lines of a resume "
+                           f"included) not a static view of a wall (--strict; every line is written), "
+                           f"first {first}: {why}")
 
 
 class _Bar:

@@ -51,8 +51,9 @@ def simulate(
     size: str = typer.Option("320x240", "--size", help="Frame size WxH in pixels (even numbers for .mp4)."),
     grid: Optional[str] = typer.Option(None, "--grid", help="Wall points RxC where the irradiance is rendered and interpolated "
                                        "to pixels (default 64x64 for a video, 24x32 in dataset mode, for speed: the signal is smooth)."),
-    crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality for .mp4 (0 = lossless, 18 = visually clean, 28 = "
-                            "strong compression that erases faint signals)."),
+    crf: Optional[int] = number_option(None, "--crf", lo=0, hi=51, integer=True, help="H.264 quality for .mp4 and "
+                                       ".mov (0 = lossless, 18 = visually clean and the default, 28 = strong "
+                                       "compression that erases faint signals); refused for .mkv (lossless) and .y4m (raw)."),
     world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the paper's 2-D world (supplementary §4) "
                               "(people = 1-2 moving occluders, horizontal information only); pt: the same rooms and "
                               "motions path traced by Mitsuba 3 (people of boxes, three bounces; needs "
@@ -143,6 +144,8 @@ def simulate(
     if dataset is not None:
         if world == "flatland" and task != "count":
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
+        if crf is not None:  # each scene's camera draws its own codec and quality from --domain
+            raise UsageError("--crf applies to one video; a --dataset's scenes draw their compression from --domain")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
                         json_out, placement, spp, draws)
     if world == "mixed":
@@ -154,6 +157,12 @@ def simulate(
     suffix = output.suffix.lower()
     if suffix not in (".mp4", ".mkv", ".y4m", ".mov"):
         raise UsageError(f"-o must end in .mp4, .mkv or .y4m (got {output})")
+    if crf is not None and suffix not in (".mp4", ".mov"):
+        # the file would be lossless while the sidecar said crf: what was asked for is not what is written
+        raise UsageError(f"--crf sets H.264 compression (.mp4, .mov); {suffix} is written "
+                         f"{'losslessly (FFV1)' if suffix == '.mkv' else 'raw'}, without it",
+                         hint="drop --crf, or write .mp4")
+    crf = 18 if crf is None else crf
     w, h = _size(size, "--size", 8192)
     if suffix in (".mp4", ".mov") and (w % 2 or h % 2):
         raise UsageError(f"H.264 needs an even frame size (got {w}x{h})")

@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (THREADS_HELP, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (stream_option, THREADS_HELP, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 number_option, strict_option, threads_option)
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
@@ -78,6 +78,7 @@ def snr(
     frames: float = _predict_option("frames"),
     force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
+    stream: Optional[int] = stream_option(),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
@@ -99,6 +100,9 @@ def snr(
       wallcli snr --predict --distance 2.5 --mean-code 120 --gain 4 --pixels 10000
       wallcli snr --predict --sweep distance=1:4:0.25 --plot fade.png
     """
+    from wallcli.cli.common import use_stream
+
+    use_stream(stream)
     from wallcli.errors import UsageError
     from wallcli.io.writer import committed_together
 

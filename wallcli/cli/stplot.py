@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
@@ -26,6 +26,7 @@ def stplot(
     json_out: bool = typer.Option(False, "--json", help="Print a metadata summary as JSON on stdout."),
     force: bool = typer.Option(False, "--force", help=force_help("the -o and --png files")),
     threads: int = threads_option(THREADS_HELP),
+    stream: Optional[int] = stream_option(),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
     64 positions x time x RGB) and over columns (vertical plot).
@@ -40,6 +41,9 @@ def stplot(
       wallcli stplot clip.mp4 --roi 100,50,640,360 --png w.png --style diverging
       ffmpeg -i rtsp://cam/s -f nut - | wallcli stplot - --mean ema -o live.npz
     """
+    from wallcli.cli.common import use_stream
+
+    use_stream(stream)
     from wallcli.errors import UsageError
 
     if output is None and png is None and not json_out:
@@ -57,10 +61,17 @@ def stplot(
     from wallcli.io.writer import check_outputs, committed_together
     from wallcli.signal.stplot import compute_stplot
 
+    from wallcli.io.video import FrameTee
+    from wallcli.signal.view import ViewCheck
+
     check_outputs([output, png], force=force, inputs=[input])
+    # the view check and the camera's shifts ride on the same decode: the .npz keeps both, so that
+    # count and activity read from it answer as they would from the video (view verdict, shake)
+    check = ViewCheck(roi_t)
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
-            plot = compute_stplot(reader, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, progress=advance)
+            plot = compute_stplot(FrameTee(reader, (check,)), roi=roi_t, bins=bins, mean=mean,
+                                  mean_seconds=mean_seconds, progress=advance, register=True, view=check)
     narrow = narrow_roi(plot.meta["roi"], plot.bins)
     if narrow:
         from wallcli.cli.output import warn
@@ -87,6 +98,12 @@ def narrow_roi(roi, bins: int) -> str | None:
             f"pixels, so the plots hold at most {min(w, h)} independent positions (use a larger ROI or --bins)")
 
 
+def check_summary(meta: dict) -> dict | None:
+    from wallcli.signal.view import ViewCheck
+
+    return ViewCheck.restore(meta["view"]).summary() if isinstance(meta.get("view"), dict) else None
+
+
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:
     from wallcli.cli.output import emit_json
     from wallcli.io.arrays import save_npz
@@ -106,4 +123,5 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
             "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
             "signal_rms": [float(x) for x in plot.horizontal.std(axis=(0, 1))],
             "warnings": m.get("warnings", []),
+            "view": check_summary(m),
         })

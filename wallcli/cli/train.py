@@ -103,7 +103,7 @@ def train(
     from wallcli.cli.output import console_err, log
     from wallcli.errors import UsageError
     from wallcli.infer.card import card_path
-    from wallcli.io.writer import check_outputs
+    from wallcli.io.writer import check_output, check_outputs
     from wallcli.train.augment import DESCRIPTION, SUPERPOSE_DESCRIPTION
     from wallcli.train.export import export_model
     from wallcli.train.loop import ANNEAL_FLOOR, TrainConfig, train as run_training
@@ -133,7 +133,12 @@ def train(
         raise UsageError("--device cuda: this PyTorch sees no CUDA GPU", hint="train with --device cpu")
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
-    check_outputs([out, card_path(out)], force=force)
+    read = [f for d in [*data, val, *calibrate] if d is not None
+            for f in [Path(d) / "dataset.json", *sorted(Path(d).glob("shard-*.npz"))]] + [init]
+    check_outputs([out, card_path(out)], force=force, inputs=read)
+    # the checkpoint is read and rewritten by every run of this training (no --force needed), but
+    # it must not be one of the data's files, or the model's
+    check_output(checkpoint or out.with_suffix(".ckpt.pt"), force=True, inputs=[*read, out, card_path(out)])
     init_info = None
     if init is not None:
         from wallcli.infer.card import read_card, sha256_file

@@ -51,6 +51,7 @@ class Labels:
     source: str  # 'labels.csv' or 'sidecars'
     has_snr: bool  # the labels give each clip's SNR (an snr_db column)
     damaged: list[tuple[str, str]] = field(default_factory=list)  # (clip, why its sidecar cannot be used)
+    files: list[Path] = field(default_factory=list)  # the label files read: labels.csv, or every .json looked at
 
 
 def read_labels(folder: str | Path) -> Labels:
@@ -61,13 +62,13 @@ def read_labels(folder: str | Path) -> Labels:
         raise WallcliError(f"{folder} is not a folder; give the folder that holds the clips and their labels")
     if (d / LABELS).is_file():
         clips, has_snr = _from_csv(d)
-        return Labels(clips, LABELS, has_snr)
+        return Labels(clips, LABELS, has_snr, files=[d / LABELS])
     clips, damaged = _from_sidecars(d)
     if not clips:
         why = f" ({len(damaged)} damaged: {damaged[0][1]})" if damaged else ""
         raise WallcliError(f"{folder} has no labels: looked for {LABELS} (columns {', '.join(REQUIRED)}) and for "
                            f"*.json sidecars with 'people' and 'activity' (as 'wallcli simulate' writes them){why}")
-    return Labels(clips, "sidecars", False, damaged)
+    return Labels(clips, "sidecars", False, damaged, files=sorted(d.glob("*.json")))
 
 
 def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:

@@ -36,12 +36,16 @@ def decided(row: dict) -> bool:
 
 
 def bootstrap_ci(hits: np.ndarray, *, n: int = BOOTSTRAP, seed: int = SEED) -> list[float] | None:
-    """95 % percentile interval of the mean of 0/1 ``hits``, resampling clips."""
+    """95 % percentile interval of the mean of 0/1 ``hits``, resampling clips.
+
+    A resample of N clips with replacement holds Binomial(N, k/N) right answers (k right in
+    ``hits``): drawn as that, the same distribution costs memory of the resamples only, not of
+    resamples x clips (10 000 x 100 000 clips was 8 GB)."""
     hits = np.asarray(hits, np.float64)
     if hits.size == 0:
         return None
     rng = np.random.default_rng(seed)
-    means = hits[rng.integers(0, hits.size, (n, hits.size))].mean(axis=1)
+    means = rng.binomial(hits.size, float(hits.sum()) / hits.size, n) / hits.size
     lo, hi = np.percentile(means, [2.5, 97.5])
     return [float(lo), float(hi)]
 

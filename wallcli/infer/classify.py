@@ -24,10 +24,13 @@ from wallcli.signal.window import StreamWindower, resample, window_signal_db, wi
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
 
 
-def _too_short(source: str, frames: int, model) -> WallcliError:
+def _too_short(source: str, frames: int, model, fps: float | None = None) -> WallcliError:
+    """``frames``: the file's own frames, as decoded (what snr and the report quote), at its own
+    rate ``fps`` (None: the model's), not the resampled samples the windows are cut from."""
+    fps = float(fps) if fps else float(model.fps)
     return WallcliError(
-        f"{source} is too short: {frames} frame(s) at {model.fps:g} fps ({frames / model.fps:.2f} s); "
-        f"one window needs {model.window} frames ({model.window / model.fps:.2f} s)")
+        f"{source} is too short: {frames} frame(s) decoded ({frames / fps:.2f} s at {fps:g} fps); "
+        f"one window needs {model.window} frames at {model.fps:g} fps ({model.window / model.fps:.2f} s)")
 
 
 def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None]:
@@ -124,26 +127,43 @@ def _corrected(model, wins: dict, offsets: dict, native, options, starts=None, s
 
 def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
+    from wallcli.io.video import check_rate
+
+    if native_fps(plot.time) is not None:  # a plot of an older wallcli, made before videos were checked
+        check_rate(native_fps(plot.time), source)
     plots, grid = resampled_plots(model, plot, both=corrections.light)
+    shifts = None
+    if corrections.shake and getattr(plot, "shift", None) is not None and plot.frames >= 2:
+        # resampled as the profiles are, as the stream's extra row is (RowStream)
+        ext = np.zeros((1, plot.frames, 3), np.float32)
+        ext[0, :, :2] = plot.shift
+        shifts = resample(ext, plot.time, model.fps)[0][0, :, :2].astype(np.float64)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     frames = len(grid) if plot.frames >= 2 else plot.frames
     starts = window_starts(frames, model.window, stride)
     if not starts:
-        raise _too_short(source, frames, model)
+        raise _too_short(source, plot.frames, model, native_fps(plot.time))
     probs, signal, found = [], [], []
     native = native_fps(plot.time)
     for i in range(0, len(starts), CHUNK):
         chunk = starts[i:i + CHUNK]
         wins = {name: np.stack([p[:, s:s + model.window] for s in chunk]) for name, p in plots.items()}
         wins, f = _corrected(model, wins, {n: offsets[n][None] for n in wins}, native, corrections,
-                             starts=[grid[s] for s in chunk])
+                             starts=[grid[s] for s in chunk],
+                             shifts=None if shifts is None else np.stack([shifts[s:s + model.window] for s in chunk]))
         found += f
         wins = {name: wins[name] for name in model.input_names}
         probs.append(model.classify(wins, {name: offsets[name][None] for name in wins}))
         signal.append(window_signal_db([(w, offsets[name][None]) for name, w in wins.items()]))
-    return _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
-                   stride=stride, source=source, found=found)
+    result = _result(model, [grid[s] for s in starts], np.concatenate(probs), np.concatenate(signal),
+                     stride=stride, source=source, found=found)
+    view = (plot.meta or {}).get("view")
+    if isinstance(view, dict):  # the verdict of the video's check, kept by stplot
+        from wallcli.signal.view import ViewCheck
+
+        result = with_view(result, ViewCheck.restore(view))
+    return result
 
 
 def _predict_window(model, win: np.ndarray, ref: np.ndarray, *, start: float = 0.0, native=None,
@@ -202,12 +222,14 @@ class WindowClassifier:
             self.found.append(f)
             self._emitted = self.windower.count
 
-    def result(self, source: str) -> dict[str, Any]:
-        """The docs/contract.md result; WallcliError when the stream was shorter than one window."""
+    def result(self, source: str, frames: int | None = None) -> dict[str, Any]:
+        """The docs/contract.md result; WallcliError when the stream was shorter than one window
+        (quoting ``frames``, the video's decoded frames, where given)."""
         model, w = self.model, self.windower
         last = w.last()
         if last is None:
-            raise _too_short(str(source), w.count, model)
+            raise _too_short(str(source), w.count if frames is None else frames, model,
+                             None if frames is None else self.native_fps)
         times, probs, signal, found = list(self.times), list(self.probs), list(self.signal), list(self.found)
         if self._emitted != w.count:  # window_starts' end-aligned window: the last `window` rows
             p, db, f = _predict_window(model, last[2], self.ref, start=last[0], native=self.native_fps,
@@ -267,7 +289,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             if thumb is not None:
                 thumb.push(t, row)
             classifier.push(t, stream_row(row, rows), rows.ref)
-    result = with_view(classifier.result(str(source)), check)
+    result = with_view(classifier.result(str(source), frames=rows.frames), check)
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
@@ -330,4 +352,4 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
                 rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
                 yield judge_view(rec, check.view(rec["start"], rec["end"]))
     if windower.count < model.window:
-        raise _too_short(str(source), windower.count, model)
+        raise _too_short(str(source), rows.frames, model, float(reader.info.fps))

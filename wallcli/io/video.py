@@ -17,6 +17,7 @@ import queue
 import re
 import threading
 import warnings
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -35,6 +36,20 @@ _GRAY_RE = re.compile(r"^gray(\d+)?(le|be)?$")
 _SUB = {"420": (1, 1), "422": (1, 0), "444": (0, 0), "440": (0, 1), "411": (2, 0), "410": (2, 1)}
 
 _QUEUE_SIZE = 8
+
+# The frame rates wallcli reads. The models see 8.5 s windows resampled to 30 fps, trained on 15-60 fps
+# videos, and the SNR estimator (paper suppl. 3.2) takes what lasts from one frame to the next as
+# signal: far below 10 fps a person moves across the wall between two frames and both would be
+# answering about interpolated samples (a 0.5 fps file gave eight windows and 32 dB, snr -99 dB);
+# far above 240 fps, the timestamps of slow-motion files are rarely the capture's.
+MIN_FPS, MAX_FPS = 10.0, 240.0
+
+
+def check_rate(fps: float, source: str) -> None:
+    """Refuse a frame rate outside MIN_FPS-MAX_FPS: one line, the same for every command."""
+    if not (MIN_FPS <= float(fps) <= MAX_FPS):
+        raise WallcliError(f"{source}: {float(fps):.3g} fps; wallcli reads videos of {MIN_FPS:g} to {MAX_FPS:g} fps "
+                           "(the models' windows and the SNR estimator assume frames a fraction of a second apart)")
 
 
 @dataclass
@@ -136,6 +151,15 @@ class Frame:
     time: float
     planes: Planes
     _keep: object = field(default=None, repr=False)  # the av.VideoFrame whose buffers the planes view
+    gap: float = 0.0  # seconds since the frame before, when the timestamps jump there (frames lost): 0 otherwise
+
+
+# A jump of the timestamps over GAP_FACTOR typical frame intervals, and over GAP_MIN seconds, is frames
+# lost (corruption, a dropped stretch of a stream), not a variable frame rate's slower frame (phones:
+# up to about 2x; a few frames' pause is interpolated over like any resampling)
+GAP_FACTOR = 5.0
+GAP_MIN = 0.25
+GAP_HISTORY = 16  # recent intervals whose median is the typical one
 
 
 def _plane_array(plane, width: int, height: int, dtype) -> np.ndarray:
@@ -184,6 +208,44 @@ STDIN_MP4 = ("-: an MP4 cannot be streamed on stdin (its index is at the end of 
              "(ffmpeg -i clip.mp4 -c copy -f mpegts -)")
 
 
+def rotate_planes(planes: Planes, k: int) -> Planes:
+    """``planes`` turned by k quarter turns counterclockwise (np.rot90's sense), each plane copied
+    to contiguous memory; a quarter turn swaps the chroma's horizontal and vertical subsampling."""
+    k %= 4
+    if not k:
+        return planes
+
+    def turn(a):
+        return None if a is None else np.ascontiguousarray(np.rot90(a, k))
+
+    sx, sy = (planes.sub_y, planes.sub_x) if k % 2 else (planes.sub_x, planes.sub_y)
+    return Planes(turn(planes.y), turn(planes.u), turn(planes.v), kind=planes.kind, sub_x=sx, sub_y=sy,
+                  depth=planes.depth, matrix=planes.matrix, full_range=planes.full_range)
+
+
+def quarter_turns(rotation) -> int | None:
+    """np.rot90's k that shows a frame as its display matrix asks (FFmpeg's ``rotation``: degrees
+    the matrix turns the frame counterclockwise); None for an angle that is not a quarter turn."""
+    angle = float(rotation or 0.0)
+    k = round(angle / 90.0)
+    return k % 4 if abs(angle - 90.0 * k) < 1.0 else None
+
+
+# The video stream to read (its index in the file, as ffprobe numbers them), for commands given
+# --stream N (cli.common.use_stream); None: the first real video stream
+STREAM: ContextVar[int | None] = ContextVar("wallcli_stream", default=None)
+
+
+def _real_video(stream) -> bool:
+    """A stream of moving pictures that FFmpeg can decode, not a cover picture or a thumbnail track."""
+    d = getattr(stream, "disposition", None)
+    try:
+        still = bool(d & (d.__class__.attached_pic | d.__class__.timed_thumbnails | d.__class__.still_image))
+    except (AttributeError, TypeError):
+        still = False
+    return not still and stream.codec_context is not None
+
+
 def _describe_open_error(source: str, exc: Exception) -> WallcliError:
     text = str(exc)
     if isinstance(exc, FileNotFoundError) or "No such file" in text:
@@ -200,7 +262,8 @@ def _is_url(source: str) -> bool:
 class VideoReader:
     """Open with :func:`open_video`; iterate :meth:`frames` once (decode once, stream)."""
 
-    def __init__(self, source: str, *, threads: int = 0, input_format: str | None = None):
+    def __init__(self, source: str, *, threads: int = 0, input_format: str | None = None,
+                 stream_index: int | None = None):
         import av
 
         self.source = source
@@ -233,10 +296,11 @@ class VideoReader:
         if not self._container.streams.video:
             self._container.close()
             raise WallcliError(f"{source} has no video stream")
-        stream = self._container.streams.video[0]
-        if stream.codec_context is None:  # a codec FFmpeg has no decoder for (or a damaged header naming one)
+        try:
+            stream = self._pick_stream(source, STREAM.get() if stream_index is None else stream_index)
+        except WallcliError:
             self._container.close()
-            raise WallcliError(f"{source}: FFmpeg cannot decode its video codec")
+            raise
         stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
         stream.codec_context.thread_count = int(threads)
         self._stream = stream
@@ -245,6 +309,14 @@ class VideoReader:
             rate = Fraction(30)
             self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
         fps = Fraction(rate).limit_denominator(1001)
+        try:
+            # the measured rate only: a container that gives none leaves FFmpeg guessing from its time
+            # base (Matroska's 1000), which says nothing of the frames
+            if stream.average_rate:
+                check_rate(fps, source)
+        except WallcliError:
+            self._container.close()
+            raise
         count = int(stream.frames or 0) or None
         self._declared_frames = count  # exact where the container says (mp4); estimates are not
         duration = None
@@ -266,8 +338,69 @@ class VideoReader:
             codec=str(cc.name or ""),
             container=str(self._container.format.name or ""),
         )
+        self.rotation = 0  # quarter turns (np.rot90's k) applied to every frame: its display matrix
+        self._rotation_noted = False
+        self._peek_rotation(target, fmt, options)
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs
+        self.gaps: list[tuple[float, float]] = []  # (time of the frame before, time of the frame after) per jump
+
+    def _pick_stream(self, source: str, index: int | None):
+        """The video stream to read: ``index`` (--stream N) or the first real one; a file with
+        several says which was taken."""
+        videos = list(self._container.streams.video)
+        if index is not None:
+            chosen = [s for s in videos if s.index == index]
+            if not chosen:
+                names = ", ".join(str(s.index) for s in videos)
+                raise WallcliError(f"{source} has no video stream {index} (its video streams: {names})")
+            stream = chosen[0]
+        else:
+            real = [s for s in videos if _real_video(s)]
+            stream = real[0] if real else videos[0]
+            if len(videos) > 1:
+                self.warnings.append(f"{source} has {len(videos)} video streams; reading stream {stream.index} "
+                                     f"({stream.codec_context.name if stream.codec_context else '?'}, "
+                                     f"{stream.codec_context.width if stream.codec_context else '?'}x"
+                                     f"{stream.codec_context.height if stream.codec_context else '?'}); "
+                                     "--stream N reads another")
+                warnings.warn(self.warnings[-1], VideoWarning, stacklevel=3)
+        if stream.codec_context is None:  # a codec FFmpeg has no decoder for (or a damaged header naming one)
+            raise WallcliError(f"{source}: FFmpeg cannot decode its video codec")
+        return stream
+
+    def _peek_rotation(self, target: str, fmt, options) -> None:
+        """A file's display rotation (its first frame's display matrix), known before the frames
+        are read so that the announced size is the size shown. Streams and URLs are not read twice:
+        their frames are turned as they come, and the size is the decoded frame's (as everywhere)."""
+        if target != self.source or _is_url(self.source) or not os.path.isfile(self.source):
+            return  # (a pipe or a device read twice would lose what the first read took)
+        import av
+
+        try:
+            with av.open(target, mode="r", format=fmt, options=options, timeout=30.0) as c:
+                s = c.streams[self._stream.index]
+                for frame in c.decode(s):
+                    k = quarter_turns(frame.rotation)
+                    self.rotation = k or 0
+                    if k and k % 2:
+                        self.info.width, self.info.height = self.info.height, self.info.width
+                    break
+        except (av.error.FFmpegError, OSError, ValueError, IndexError):
+            pass  # the real read reports what is wrong
+
+    def _turn(self, frame, planes: Planes) -> Planes:
+        k = quarter_turns(getattr(frame, "rotation", 0))
+        if k is None:
+            if not self._rotation_noted:
+                self._rotation_noted = True
+                self._warn(f"{self.source}: a display rotation of {-float(frame.rotation):g} degrees is not applied "
+                           "(only quarter turns are); frames are read as stored")
+            return planes
+        if k and not self._rotation_noted:
+            self._rotation_noted = True
+            self.warnings.append(f"{self.source}: display rotation of {(-90 * k) % 360} degrees applied")
+        return rotate_planes(planes, k)
 
     # -- decoding -------------------------------------------------------------------------------
     def _decode_into(self, q: "queue.Queue", stop: threading.Event) -> None:
@@ -312,6 +445,10 @@ class VideoReader:
         last_time = -np.inf
         tb = self._stream.time_base
         fps = float(self.info.fps)
+        from collections import deque
+
+        recent: deque = deque(maxlen=GAP_HISTORY)
+        self.gaps = []
         try:
             while True:
                 kind, item = q.get()
@@ -326,8 +463,17 @@ class VideoReader:
                     if t <= last_time:
                         # Duplicate or out-of-order timestamps (broken muxers): keep time monotonic.
                         t = last_time + 1.0 / fps
+                    gap = 0.0
+                    if index:
+                        dt = t - last_time
+                        typical = float(np.median(recent)) if len(recent) >= 4 else 1.0 / fps
+                        if dt > GAP_FACTOR * typical and dt > max(GAP_FACTOR / fps, GAP_MIN):
+                            gap = dt
+                            self.gaps.append((round(last_time, 4), round(t, 4)))
+                        else:
+                            recent.append(dt)
                     last_time = t
-                    yield Frame(index, t, frame_planes(frame), frame)
+                    yield Frame(index, t, self._turn(frame, frame_planes(frame)), frame, gap)
                     index += 1
                 elif kind == "damage":
                     if index == 0 and self._mp4_on_a_pipe():
@@ -339,6 +485,11 @@ class VideoReader:
                 else:
                     if item:
                         self._warn(f"{self.source}: skipped {item} corrupt packet(s)/frame(s)")
+                    if self.gaps:
+                        shown = ", ".join(f"{b - a:.2f} s after {a:.2f} s" for a, b in self.gaps[:3])
+                        more = f" and {len(self.gaps) - 3} more" if len(self.gaps) > 3 else ""
+                        self._warn(f"{self.source}: frames missing (the timestamps jump): {shown}{more}; "
+                                   "what spans a gap is not analysed as continuous (view: 'frame gap')")
                     self._check_complete(index, last_time)
                     break
         finally:
@@ -422,6 +573,9 @@ class VideoWarning(UserWarning):
     """Recoverable trouble in a video (corrupt packets, truncation); the CLI prints these once."""
 
 
-def open_video(source: str | os.PathLike, *, threads: int = 0, input_format: str | None = None) -> VideoReader:
-    """Open a path, an http(s)/rtsp URL, '-' (a streamable container on stdin) or /dev/videoN."""
-    return VideoReader(str(source), threads=threads, input_format=input_format)
+def open_video(source: str | os.PathLike, *, threads: int = 0, input_format: str | None = None,
+               stream: int | None = None) -> VideoReader:
+    """Open a path, an http(s)/rtsp URL, '-' (a streamable container on stdin) or /dev/videoN.
+    ``stream``: the video stream's index in the file (default: :data:`STREAM`, else the first
+    real video stream)."""
+    return VideoReader(str(source), threads=threads, input_format=input_format, stream_index=stream)

@@ -118,14 +118,37 @@ def _temporary(out: Path) -> Path:
     return Path(name)
 
 
+# files read together with an input of this suffix: a model's card beside it (wallcli.infer.card)
+_READ_BESIDE = {".onnx": (".json",)}
+
+
+def read_with(inputs: Iterable) -> list[Path]:
+    """Every file a command reads for ``inputs`` (paths; None, '-' and URLs are skipped): each one,
+    and what is read beside it, so an output can be checked against all of them: a model (.onnx)
+    brings its card (.json). Folders are left to the caller, which knows which of their files it
+    reads (labels.csv, sidecars, a dataset's manifest and shards)."""
+    out: list[Path] = []
+    for src in inputs:
+        if src is None or str(src) in ("", "-") or "://" in str(src):
+            continue
+        p = Path(str(src))
+        out.append(p)
+        out += [p.with_suffix(s) for s in _READ_BESIDE.get(p.suffix.lower(), ())]
+    return out
+
+
 def check_output(path: str | os.PathLike, *, force: bool = False, inputs: Iterable = ()) -> Path:
-    """Validate an output path before any work starts, so a long job never fails at the end."""
+    """Validate an output path before any work starts, so a long job never fails at the end.
+
+    ``inputs``: every file the command reads (see :func:`read_with`, applied here); an output that
+    is one of them, by any name (a link, a hard link, ``./``), is refused, --force or not: --force
+    replaces an earlier output, never an input."""
     out = Path(path)
     if str(path) in ("", "-"):
         raise WallcliError("this output must be a file path, not '-'")
-    for src in inputs:
-        if src is not None and str(src) != "-" and _same_file(out, Path(str(src))):
-            raise WallcliError(f"output {out} is the input; wallcli never overwrites an input")
+    for src in read_with(inputs):
+        if _same_file(out, src):
+            raise WallcliError(f"output {out} is the input {src}; wallcli never overwrites an input, --force or not")
     _check_target(out, force=force)
     parent = out.parent if str(out.parent) else Path(".")
     if not os.access(parent, os.W_OK):

@@ -14,6 +14,17 @@ def new_figure(*args, **kwargs):
     return plt.subplots(*args, **kwargs)
 
 
+def picture_height(width_in: float, w: int, h: int) -> float:
+    """Inches of height for a picture of w x h pixels drawn ``width_in`` inches wide: its aspect,
+    held between 1:8 and 2:1 (a 1x1000 video drawn to scale was an 8000-inch figure, out of memory)."""
+    return width_in * min(max(h / max(w, 1), 1 / 8), 2.0)
+
+
+def picture_aspect(w: int, h: int) -> str:
+    """imshow's aspect for :func:`picture_height`: to scale, unless the height was held."""
+    return "equal" if 1 / 8 <= h / max(w, 1) <= 2.0 else "auto"
+
+
 def save_figure(fig, path, *, force: bool = False, dpi: int = 120) -> None:
     import matplotlib.pyplot as plt
     from matplotlib.text import Text

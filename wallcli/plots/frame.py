@@ -12,9 +12,11 @@ def save_frame_png(path, rgb: np.ndarray, roi, *, title: str = "", force: bool =
     from matplotlib.patches import Rectangle
 
     h, w = rgb.shape[:2]
-    fig, ax = new_figure(figsize=(8, 8 * h / max(w, 1) + 0.8), constrained_layout=True)
+    from wallcli.plots.figure import picture_aspect, picture_height
+
+    fig, ax = new_figure(figsize=(8, picture_height(8, w, h) + 0.8), constrained_layout=True)
     # display only: the analysis never sees these rounded, clipped values
-    ax.imshow(np.clip(rgb / 255.0, 0.0, 1.0), extent=(0, w, h, 0), interpolation="nearest")
+    ax.imshow(np.clip(rgb / 255.0, 0.0, 1.0), extent=(0, w, h, 0), interpolation="nearest", aspect=picture_aspect(w, h))
     x, y, rw, rh = roi
     ax.add_patch(Rectangle((x, y), rw, rh, fill=False, edgecolor="cyan", lw=2, label=f"ROI {x},{y},{rw},{rh}"))
     ax.legend(loc="upper right", fontsize=8)

@@ -20,8 +20,10 @@ def save_heatmap_png(path, grid, *, of: str = "signal", chosen=None, avoid=None,
     s, n = sig.mean(axis=2), noi.mean(axis=2)
     x, y, w, h = grid.grid_roi
     extent = (x, x + w, y + h, y)
-    fig, ax = new_figure(figsize=(8, 8 * h / max(w, 1) + 1.0), constrained_layout=True)
-    ax.imshow(lum, cmap="gray", extent=extent, interpolation="bilinear")
+    from wallcli.plots.figure import picture_aspect, picture_height
+
+    fig, ax = new_figure(figsize=(8, picture_height(8, w, h) + 1.0), constrained_layout=True)
+    ax.imshow(lum, cmap="gray", extent=extent, interpolation="bilinear", aspect=picture_aspect(w, h))
     if of == "snr":
         with np.errstate(divide="ignore", invalid="ignore"):
             data = np.where((s > 0) & (n > 0), 10 * np.log10(s / n), np.nan)

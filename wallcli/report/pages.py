@@ -31,6 +31,36 @@ def _task_view(task: str, result: dict | None, failure: str | None, figure: str 
             "undetermined": sum(not w["answer"]["decided"] for w in windows), "finding": finding(task, result)}
 
 
+def _correction_text(c: dict) -> str:
+    """One correction as a line of text: its kind and what was found (lists summarised)."""
+    parts = []
+    for k, v in c.items():
+        if k == "kind":
+            continue
+        if isinstance(v, list):
+            v = f"{len(v)}"
+        elif isinstance(v, float):
+            v = f"{v:.4g}"
+        parts.append(f"{k.replace('_', ' ')} {v}")
+    return str(c.get("kind", "?")) + (f" ({', '.join(parts)})" if parts else "")
+
+
+def corrections_view(a) -> dict[str, Any]:
+    """What the page says of the corrections: those asked for and off, and per analysis what was
+    found and removed before it (the JSON's ``corrections``)."""
+    opts = a.options
+    off = [flag for flag, on in (("--no-deflicker", getattr(opts, "deflicker", True)),
+                                 ("--no-exposure", getattr(opts, "exposure", True)),
+                                 ("--no-shake", getattr(opts, "shake", True))) if not on]
+    found = []
+    for where, items in (("count", (a.results.get("count") or {}).get("corrections")),
+                         ("activity", (a.results.get("activity") or {}).get("corrections")),
+                         ("signal and noise", a.snr_corrections)):
+        if items is not None:
+            found.append({"where": where, "items": [_correction_text(c) for c in items]})
+    return {"off": off, "found": found}
+
+
 def clip_page(a, *, command: str) -> str:
     """The HTML report of a :class:`wallcli.report.analysis.ClipAnalysis`."""
     from wallcli.report.cards import model_summary
@@ -46,8 +76,9 @@ def clip_page(a, *, command: str) -> str:
         snr={"rows": _snr_rows(a.snr), "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
              "pixels": a.snr.sampled_pixels, "channels": CHANNELS},
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
-        plot={"bins": a.plot.bins, "frames": a.plot.frames},
+        plot={"bins": a.plot.bins, "frames": a.identity["frames"]},
         figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],
+        corrections=corrections_view(a), view=a.view,
     )
 
 

@@ -32,6 +32,9 @@ class StPlot:
     h_mean: np.ndarray  # (bins, 3) float32: the clip mean of the raw levels (what was removed, for 'clip')
     v_mean: np.ndarray
     meta: dict = field(default_factory=dict)
+    # (T, 2) float32: each frame's measured camera shift (dx, dy) in luma pixels, where the frames were
+    # registered (compute_stplot(register=True)): count and activity regress the shake out of the plot with it
+    shift: np.ndarray | None = None
 
     @property
     def frames(self) -> int:
@@ -81,7 +84,7 @@ class _Growing:
         return self._a[: self.n]
 
 
-def _finish(h_raw, v_raw, times, meta, mean: str, mean_seconds: float) -> StPlot:
+def _finish(h_raw, v_raw, times, meta, mean: str, mean_seconds: float, shift=None) -> StPlot:
     h_raw = h_raw.astype(np.float64)
     v_raw = v_raw.astype(np.float64)
     h = remove_mean(h_raw, times, mean, mean_seconds)
@@ -93,6 +96,7 @@ def _finish(h_raw, v_raw, times, meta, mean: str, mean_seconds: float) -> StPlot
         h_mean=h_raw.mean(axis=0).astype(np.float32),
         v_mean=v_raw.mean(axis=0).astype(np.float32),
         meta=meta,
+        shift=None if shift is None else np.asarray(shift, np.float32),
     )
 
 
@@ -104,8 +108,14 @@ def compute_stplot(
     mean: str = "clip",
     mean_seconds: float = 10.0,
     progress: Callable[[int], None] | None = None,
+    register: bool = False,
+    view=None,
 ) -> StPlot:
-    """Stream ``reader`` (a :class:`wallcli.io.video.VideoReader`) once into space-time plots."""
+    """Stream ``reader`` (a :class:`wallcli.io.video.VideoReader`) once into space-time plots.
+
+    ``register``: also measure each frame's camera shift (:attr:`StPlot.shift`), for the shake
+    correction of answers read from the plot. ``view``: the :class:`wallcli.signal.view.ViewCheck`
+    fed the same frames (e.g. through a FrameTee); its record goes into the metadata ("view")."""
     from wallcli.errors import WallcliError
 
     if mean not in MODES:
@@ -114,16 +124,19 @@ def compute_stplot(
     requested = roi
     frame_size = [info.width, info.height]
     roi = check_roi(requested, info.width, info.height)
-    reduce = RowReducer(roi, bins)
+    reduce = RowReducer(roi, bins, register=register)
     h_rows, v_rows, times = _Growing((bins, 3)), _Growing((bins, 3)), _Growing((), np.float64)
+    shifts = _Growing((2,)) if register else None
     for frame in reader.frames():
         if frame.index == 0 and (frame.planes.width, frame.planes.height) != (info.width, info.height):
             # the container's size was wrong or unknown (some streams): the decoded frame decides,
             # and the default ROI is then the whole decoded frame, not the announced one
             frame_size = [frame.planes.width, frame.planes.height]
             roi = check_roi(requested, *frame_size)
-            reduce = RowReducer(roi, bins)
+            reduce = RowReducer(roi, bins, register=register)
         h, v = reduce(frame.planes)
+        if shifts is not None:
+            shifts.append(reduce.shift)
         h_rows.append(h)
         v_rows.append(v)
         times.append(frame.time)
@@ -150,16 +163,22 @@ def compute_stplot(
         "wallcli_version": __version__,
         "warnings": list(getattr(reader, "warnings", [])),
     }
-    return _finish(h_rows.array(), v_rows.array(), times.array(), meta, mean, mean_seconds)
+    if view is not None:
+        meta["view"] = view.record()
+    return _finish(h_rows.array(), v_rows.array(), times.array(), meta, mean, mean_seconds,
+                   None if shifts is None else shifts.array())
 
 
 def to_arrays(plot: StPlot) -> tuple[dict[str, np.ndarray], dict]:
     """The ``.npz`` payload of a plot: ``save_npz(path, *to_arrays(plot))``."""
-    return ({"horizontal": plot.horizontal, "vertical": plot.vertical, "time": plot.time,
-             "h_mean": plot.h_mean, "v_mean": plot.v_mean}, plot.meta)
+    arrays = {"horizontal": plot.horizontal, "vertical": plot.vertical, "time": plot.time,
+              "h_mean": plot.h_mean, "v_mean": plot.v_mean}
+    if plot.shift is not None:
+        arrays["shift"] = plot.shift
+    return arrays, plot.meta
 
 
-_ARRAYS = ("horizontal", "vertical", "time", "h_mean", "v_mean")
+_ARRAYS = ("horizontal", "vertical", "time", "h_mean", "v_mean", "shift")
 
 
 def from_arrays(arrays: dict[str, np.ndarray], meta: dict, source: str = "file") -> StPlot:
@@ -189,8 +208,17 @@ def from_arrays(arrays: dict[str, np.ndarray], meta: dict, source: str = "file")
         raise WallcliError(f"{source} contains non-finite values")
     if t.size > 1 and np.any(np.diff(t) <= 0):
         raise WallcliError(f"{source} has timestamps that do not increase")
+    shift = None
+    if "shift" in arrays:
+        with np.errstate(over="ignore"):
+            shift = np.asarray(arrays["shift"], np.float32)
+        if shift.shape != (t.size, 2) or not np.all(np.isfinite(shift)):
+            raise WallcliError(f"{source} has a malformed 'shift' array (shape {shift.shape}, needs ({t.size}, 2))")
+    view = meta.get("view")
+    if view is not None and not (isinstance(view, dict) and isinstance(view.get("spans"), dict)):
+        raise WallcliError(f"{source} has a malformed view record in its metadata")
     roi = meta.get("roi")
     if roi is not None and not (isinstance(roi, list) and len(roi) == 4
                                 and all(isinstance(x, int) and not isinstance(x, bool) for x in roi)):
         raise WallcliError(f"{source} has a malformed roi in its metadata ({roi!r:.60})")
-    return StPlot(h, v, t, hm, vm, dict(meta))
+    return StPlot(h, v, t, hm, vm, dict(meta), shift)

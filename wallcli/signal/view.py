@@ -90,6 +90,10 @@ KINDS = {
     "clipped": "much of the frame is clipped",
     "too dark": "much of the frame is too dark",
     "too little usable area": "too little of the frame is usable",
+    "too thin to check": "the frame is too thin to check for camera motion",
+    # not the view's fault but the file's: frames lost (their timestamps jump, io.video.GAP_FACTOR);
+    # nothing spanning it is continuous video
+    "frame gap": "frames are missing",
 }
 
 
@@ -265,7 +269,18 @@ class ViewCheck:
         self._bad_geometry = None
 
     def __call__(self, frame) -> None:
+        gap = getattr(frame, "gap", 0.0)
+        if gap:
+            self.gap(frame.time - gap, frame.time)
         self.update(frame.time, frame.planes)
+
+    def gap(self, start: float, end: float) -> None:
+        """Frames are missing between ``start`` and ``end`` (the times of the frames either side)."""
+        spans = self.spans["frame gap"]
+        if len(spans) >= MAX_SPANS:
+            spans[-1][1] = end
+        else:
+            spans.append([round(float(start), 4), round(float(end), 4)])
 
     # ------------------------------------------------------------------ per frame
     def update(self, t: float, planes) -> None:
@@ -446,10 +461,16 @@ class ViewCheck:
         level = np.maximum(blocks, DARK)
         # camera motion: a shift of the frame's fine structure against the reference frame that
         # explains more of the change than the noise could
-        if self._window is None or self._window.shape != hp.shape:
-            self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
-        # copies: OpenCV applies the window to its inputs in place
-        (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
+        if min(hp.shape) < 2:
+            # a frame one sample thin at the check's scale (4000x16, 1x1000) has no second dimension
+            # to register on (OpenCV's window needs two): its motion cannot be judged, so say so
+            flags.add("too thin to check")
+            dx = dy = 0.0
+        else:
+            if self._window is None or self._window.shape != hp.shape:
+                self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
+            # copies: OpenCV applies the window to its inputs in place
+            (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
         shift = float(np.hypot(dx, dy)) * self._scale
         moved = False
         # a shift of half the floor that fits is not motion yet, but a shake on its way to it:
@@ -538,14 +559,38 @@ class ViewCheck:
             return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked"}
         reason = None
         if issues:
-            parts = [f"{k} at {_spans_text(found[k])}" for k in issues]
-            reason = "not a static view of the wall: " + "; ".join(parts)
+            parts = [f"{k} at {_spans_text(found[k])}" for k in issues if k != "frame gap"]
+            reason = "; ".join((["not a static view of the wall: " + "; ".join(parts)] if parts else [])
+                               + ([f"frames missing at {_spans_text(found['frame gap'])}"]
+                                  if found["frame gap"] else []))
         return {"usable": not issues, "issues": issues, "reason": reason}
+
+    def record(self) -> dict:
+        """What :meth:`view` and :meth:`summary` answer from, as JSON (a .npz plot's metadata
+        keeps it, so answers read from the plot carry the verdict of the video's check)."""
+        return {"spans": {k: [list(s) for s in v] for k, v in self.spans.items()}, "frames": self.frames,
+                "max_shift": self.max_shift, "min_usable": self.min_usable,
+                "noise": float(np.median(self._sig_b)) if self._sig_b else None}
+
+    @classmethod
+    def restore(cls, record: dict) -> "ViewCheck":
+        """A check that answers as the one whose :meth:`record` this is (nothing more is fed to it)."""
+        check = cls()
+        spans = record.get("spans") or {}
+        for kind in check.spans:  # kinds of a newer wallcli are not this one's to judge
+            check.spans[kind] = [[float(a), float(b)] for a, b in spans.get(kind, [])]
+        check.frames = int(record.get("frames") or 0)
+        check.max_shift = float(record.get("max_shift") or 0.0)
+        check.min_usable = float(record.get("min_usable", 1.0))
+        if record.get("noise") is not None:
+            check._sig_b.append(float(record["noise"]))
+        return check
 
     def summary(self) -> dict:
         """The clip's view and what it was judged on (extra fields of the JSON's ``view``)."""
         noise = float(np.median(self._sig_b)) if self._sig_b else None
-        return {**self.view(), "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
+        return {**self.view(), "gaps": [list(s) for s in self.spans["frame gap"]],
+                "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
                 "min_usable_area": round(self.min_usable, 3),
                 "noise": None if noise is None else round(noise, 4)}
 
