@@ -81,6 +81,17 @@ CHECK_RATE = 3.0  # frames checked per second of a calm view: checking every fra
 # shifts) and a mover's outline get every frame's chance, as before
 DENSE = 0.5
 
+TEX_TAU = 4.0  # seconds: the wall's texture is learnt where nothing changed, over this time
+EDGE_GRAD = 0.02  # of the level a pixel, at the outline's scale FINE: a step of 10 % (a wall's texture
+# of a few per cent a pixel, blurred by FINE, stayed under 0.9 % on the bundled examples)
+K_OUTLIER = 3.0  # RMS of the calm blocks: beyond it a pixel of either texture is an edge, not texture
+MIN_KNOWN = 2  # blocks' worth of known pixels (not edges) for a region's texture to be read
+K_TEX = 4.0  # standard errors: the texture is there (calm blocks) and gone (a changed region)
+FLAT = 0.03  # a block whose relative fine energy (at its level) is under this share of the calm
+# blocks' holds neither the wall's texture nor its noise: something flat covers it
+COLOUR = 0.06  # change of the colour planes' ratios to the luma (block medians): light keeps them
+NOTES = {"sharp light": "sharp shadow or light in view: a person near the wall or a small light"}
+
 KINDS = {
     "camera motion": "the camera moved",
     "moving object": "something moved in view",
@@ -214,6 +225,20 @@ def _highpass(img: np.ndarray, sigma: float = 4.0) -> np.ndarray:
     return img - cv2.GaussianBlur(img, (0, 0), sigma)
 
 
+def _relative_texture(small: np.ndarray, fine: np.ndarray) -> np.ndarray:
+    """The fine band relative to the local level: what a change of light leaves as it is (texture,
+    fixed pattern). Where the level itself changes fast (an edge of light, over EDGE_GRAD of the
+    level a pixel) it is NaN, unknown: the edge is no texture."""
+    import cv2
+
+    low = small - fine
+    level = np.maximum(low, 1.0)
+    gx = cv2.Sobel(low, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(low, cv2.CV_32F, 0, 1, ksize=3)
+    edge = cv2.dilate(((gx * gx + gy * gy) > (8.0 * EDGE_GRAD * level) ** 2).astype(np.uint8), np.ones((3, 3), np.uint8))
+    return np.where(edge.astype(bool), np.float32(np.nan), fine / level)
+
+
 def _broad_blur(img: np.ndarray, sigma: float) -> np.ndarray:
     """A Gaussian blur of large ``sigma`` computed at a quarter of the size (what it keeps has no
     detail finer than that) and brought back bilinearly: a tenth of the cost of the full kernel."""
@@ -261,6 +286,9 @@ class ViewCheck:
         # checked frames, and where those blocks lie in source pixels: what `snr --roi auto` avoids
         self._bad = None
         self._bad_geometry = None
+        self._tex = self._bg_c = None  # the wall's relative texture and colour ratios (see _objects)
+        self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
+        self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
 
     def __call__(self, frame) -> None:
         self.update(frame.time, frame.planes)
@@ -376,10 +404,10 @@ class ViewCheck:
         # registration reads a band: finer is mostly noise and codec residue, coarser is light
         hp = cv2.GaussianBlur(small, (0, 0), 1.5) - _broad_blur(small, 8.0)
         if self._prev_b is None or self._cut_reset:
-            self._reset(hp, small, blocks)
+            self._reset(hp, small, blocks, planes, full)
             self._cut_reset = False
         else:
-            flags |= self._changes(t, blocks, hp, ok, small, clipped)
+            flags |= self._changes(t, blocks, hp, ok, small, clipped, planes, full)
         self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
         self.frames += 1
         for kind in flags:
@@ -417,12 +445,14 @@ class ViewCheck:
             out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
         return out
 
-    def _reset(self, hp, small, blocks) -> None:
+    def _reset(self, hp, small, blocks, planes, full) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
+        self._tex = _relative_texture(small, self._bg_h)
+        self._bg_c = self._chroma(planes, blocks, full)
         self._bg_n = 1
 
-    def _changes(self, t, blocks, hp, ok, small, clipped) -> set:
+    def _changes(self, t, blocks, hp, ok, small, clipped, planes, full) -> set:
         import cv2
 
         flags = set()
@@ -508,6 +538,13 @@ class ViewCheck:
         # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
         # rules above never see them, as clipped blocks are not 'ok'
         covered = broad & clipped & (g * self._bg_b * (1 + 2 * REL) < CLIP_HI)
+        # the outline says only that the change is sharp; whether it is light or a thing is read
+        # inside it, on the wall's texture relative to its level (which light does not change)
+        rel = _relative_texture(small, fine)
+        ratio = blocks / np.maximum(g * self._bg_b, 1e-3)
+        chroma = self._chroma(planes, blocks, full) if self._bg_c is not None else None
+        if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
+            hit = self._objects(t, hit, broad & ok, ok, rel, ratio, chroma)
         hit |= covered
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
@@ -516,10 +553,121 @@ class ViewCheck:
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
+        # the wall's texture: learnt where nothing changed, slower than the background (a shadow
+        # that stays is learnt through, an object that stops is learnt like the background)
+        calm = self._pixels(~broad & ok, rel.shape)
+        b = max(1.0 - np.exp(-max(t - self._t_prev, 1e-3) / TEX_TAU), 1.0 / self._bg_n)
+        tex = self._tex
+        learn = calm & np.isfinite(rel)  # an unknown pixel (an edge) keeps what was learnt
+        self._tex = np.where(learn, np.where(np.isfinite(tex), (1 - b) * tex + b * rel, rel), tex).astype(np.float32)
+        if chroma is not None:
+            keep = ~broad & ok
+            self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c).astype(np.float32)
         return flags
 
-    def _mark(self, kind: str, t: float) -> None:
-        spans = self.spans[kind]
+    @staticmethod
+    def _pixels(mask: np.ndarray, shape) -> np.ndarray:
+        """A block mask at pixel resolution (the block grid tiles ``shape``: see _whole_blocks)."""
+        import cv2
+
+        return cv2.resize(mask.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_NEAREST).astype(bool)
+
+    def _chroma(self, planes, blocks, full) -> np.ndarray | None:
+        """(2, rows, cols): the block means of the two colour planes over the luma level (U-128 and
+        V-128 for YUV, G and B for RGB), on the luma's block grid; what a change of light keeps."""
+        import cv2
+
+        if planes.u is None or planes.v is None:
+            return None
+        roi = self.roi
+        if roi is not None and planes.kind != "rgb":
+            sx, sy = planes.sub_x, planes.sub_y
+            roi = (roi[0] >> sx, roi[1] >> sy, max(1, roi[2] >> sx), max(1, roi[3] >> sy))
+        scale = np.float32(1 << (planes.depth - 8))
+        out = []
+        for a in (planes.u, planes.v):
+            c = _whole_blocks(_shrink(_crop(a, roi), full[::-1]) / scale)
+            if planes.kind != "rgb":
+                c = c - np.float32(128.0)
+            out.append(cv2.resize(c, blocks.shape[::-1], interpolation=cv2.INTER_AREA))
+        return np.stack(out) / np.maximum(blocks, DARK)
+
+    def _objects(self, t, hit, changed, ok, rel, ratio, chroma) -> np.ndarray:
+        """The blocks of ``hit`` (sharp outlines) that bound an object rather than a change of
+        light: per connected region of changed blocks, the wall's texture (relative to the level,
+        which a change of light leaves as it is) is gone from it, or the region is flat (holds
+        neither that texture nor the noise its level brings), or its colour ratios changed. The
+        other regions are sharp light on the wall: noted (see NOTES), not refused."""
+        import cv2
+
+        tex = self._tex
+        calm = ok & ~cv2.dilate(changed.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        if not calm.any():
+            calm = ok & ~changed
+        side = _block_side(rel.shape)
+        # per block: the texture's projection and energy, the frame's own relative fine energy
+        def block_sum(a):
+            return cv2.resize(a, hit.shape[::-1], interpolation=cv2.INTER_AREA) * np.float32(side * side)
+
+        # edges are no texture: a shadow's outline in this frame, or one the learnt texture kept
+        # from where a shadow stood (it is learnt where blocks are calm, not pixels), would read
+        # as texture lost; pixels far out in either are left out (the wall's texture is a few
+        # per cent with a Gaussian's tails)
+        pc = self._pixels(calm, rel.shape)
+        sx, sm = (float(np.sqrt(np.nanmean(a[pc] ** 2))) if pc.any() else np.inf for a in (rel, tex))
+        with np.errstate(invalid="ignore"):
+            keep = (np.abs(rel) < K_OUTLIER * sx) & (np.abs(tex) < K_OUTLIER * sm)  # NaN: no
+        r, m = np.where(keep, rel, 0.0).astype(np.float32), np.where(keep, tex, 0.0).astype(np.float32)
+        xm, mm, xx = block_sum(r * m), block_sum(m * m), block_sum(r * r)
+        known = block_sum(keep.astype(np.float32))
+
+        def beta(m):
+            """Regression of the frame's relative texture on the learnt one over blocks ``m`` and
+            its standard error (pixels counted a quarter: interpolation and the codec correlate them)."""
+            smm, sxm, sxx, n = (float(np.sum(a[m], dtype=np.float64)) for a in (mm, xm, xx, known))
+            if smm <= 0.0 or n < MIN_KNOWN * side * side:
+                return 0.0, np.inf
+            b = sxm / smm
+            resid = max(sxx - b * sxm, 0.0) / n
+            return b, float(np.sqrt(4.0 * resid / smm))
+
+        b0, se0 = beta(calm)
+        registrable = b0 > K_TEX * se0 and b0 > 0.0
+        # per block, the mean relative fine energy of its known pixels (most must be known)
+        energy = np.where(known >= side * side / 2, xx / np.maximum(known, 1.0), np.inf) * np.maximum(ratio, 1.0)
+        e0 = float(np.median(energy[calm & np.isfinite(energy)])) if (calm & np.isfinite(energy)).any() else 0.0
+        n, labels = cv2.connectedComponents(changed.astype(np.uint8), connectivity=8)
+        out = np.zeros_like(hit)
+        sharp = []
+        for k in range(1, n):
+            region = labels == k
+            if not (hit & region).any():
+                continue
+            b, se = beta(region)
+            lost = registrable and b < b0 / 2 and (b0 / 2 - b) > K_TEX * se
+            flat = e0 > 0.0 and int(np.count_nonzero(region & (energy < FLAT * e0))) >= MIN_MOVER_BLOCKS
+            colour = chroma is not None and float(np.median(
+                np.hypot(*(chroma[:, region] - self._bg_c[:, region])))) > COLOUR
+            if self.trace is not None:
+                self.trace.append({"t": round(t, 3), "blocks": int(region.sum()), "hits": int((hit & region).sum()),
+                                   "beta": b, "se": se, "beta_calm": b0, "se_calm": se0,
+                                   "flat": float(np.min(energy[region])) / e0 if e0 > 0 else None,
+                                   "colour": None if chroma is None else float(np.median(
+                                       np.hypot(*(chroma[:, region] - self._bg_c[:, region])))),
+                                   "ratio": float(np.median(ratio[region])), "object": bool(lost or flat or colour)})
+            if lost or flat or colour:
+                out |= hit & region
+            else:
+                sharp.append(region)
+        if sharp and int(out.sum()) < MIN_MOVER_BLOCKS:
+            self._mark_note("sharp light", t)
+        return out
+
+    def _mark_note(self, kind: str, t: float) -> None:
+        self._mark(kind, t, self.note_spans)
+
+    def _mark(self, kind: str, t: float, where: dict | None = None) -> None:
+        spans = (self.spans if where is None else where)[kind]
         if spans and (t - spans[-1][1] < 0.5 or len(spans) >= MAX_SPANS):
             spans[-1][1] = t
         else:
@@ -527,18 +675,21 @@ class ViewCheck:
 
     # ------------------------------------------------------------------ verdicts
     def view(self, start: float | None = None, end: float | None = None) -> dict:
-        """``{"usable", "issues", "reason"}`` over [start, end] seconds (the whole clip: no bounds)."""
+        """``{"usable", "issues", "reason", "notes"}`` over [start, end] seconds (the whole clip: no
+        bounds). Notes say what was seen that is no view fault (sharp light on the wall)."""
         lo = -np.inf if start is None else start
         hi = np.inf if end is None else end
         found = {k: [s for s in spans if s[1] >= lo and s[0] <= hi] for k, spans in self.spans.items()}
         issues = [k for k, s in found.items() if s]
         if self.frames == 0:
-            return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked"}
+            return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked", "notes": []}
         reason = None
         if issues:
             parts = [f"{k} at {_spans_text(found[k])}" for k in issues]
             reason = "not a static view of the wall: " + "; ".join(parts)
-        return {"usable": not issues, "issues": issues, "reason": reason}
+        notes = [f"{NOTES[k]} (at {_spans_text(s)})" for k, spans in self.note_spans.items()
+                 if (s := [x for x in spans if x[1] >= lo and x[0] <= hi])]
+        return {"usable": not issues, "issues": issues, "reason": reason, "notes": notes}
 
     def summary(self) -> dict:
         """The clip's view and what it was judged on (extra fields of the JSON's ``view``)."""
