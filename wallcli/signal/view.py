@@ -277,7 +277,9 @@ class ViewCheck:
 
     def __init__(self, roi=None) -> None:
         self.roi = roi  # (x, y, w, h): only what the analysis reads needs to be a still wall
-        self.frames = 0
+        self.frames = 0  # checked in full
+        self.seen = 0  # fed (every decoded frame)
+        self.fps: float | None = None  # the file's rate, where a caller that quotes frames sets it
         self.spans: dict[str, list[list[float]]] = {k: [] for k in KINDS}
         self.max_shift = 0.0
         self.min_usable = 1.0
@@ -316,6 +318,7 @@ class ViewCheck:
         less than 1/CHECK_RATE s before (and nothing suspect was seen since)."""
         from wallcli.signal.blocks import one_opencv_thread
 
+        self.seen += 1
         # these images are too small for OpenCV's pool's hand-offs to pay (blocks.one_opencv_thread)
         with one_opencv_thread():
             cut = self._watch_cut(t, planes) if self._cut_t is None or t - self._cut_t >= 1.0 / CUT_RATE - 1e-3 else None
