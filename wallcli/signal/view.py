@@ -93,18 +93,21 @@ K_OUTLIER = 3.0  # RMS of the calm blocks: beyond it a pixel of either texture i
 #   (sharp-shadow walls at CRF 18: 0.1-0.4; the same walls lossless: all of it);
 # - it is flat: FLAT_SHARE % of its blocks hold under FLAT of the calm blocks' relative fine
 #   energy (at their level): neither the wall's texture nor the noise that light brings;
-# - its colour ratios moved by over COLOUR (on COLOUR_BLOCKS blocks or more: a small deep shadow
-#   under two lights of other colours moved them by up to 0.25).
-# Chosen on session 19's first 15 rounds (research/view/README.md): no wall's region was either.
+# - its colour ratios moved by over COLOUR (on COLOUR_BLOCKS blocks or more, of a background level
+#   of COLOUR_LEVEL or more: a small deep shadow under two lights of other colours moved them by up
+#   to 0.25, and on a wall of level 30 a ratio's quantisation alone is 0.03).
+# Chosen on session 19's first 16 rounds (research/view/README.md): no wall's region was either;
+# COLOUR_LEVEL after the first held-out false alarm (a wall of level 30).
 MIN_KNOWN = 4
 KEPT = 0.1
 K_TEX = 4.0
 FLAT, FLAT_SHARE = 0.02, 10
-COLOUR, COLOUR_BLOCKS = 0.1, 4
+COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL = 0.1, 4, 60.0
 NOTES = {"sharp light": "sharp shadow or light in view: a person near the wall or a small light"}
 
-REGISTRABLE = 0.25  # the usual texture match (see _texture_match) of a wall whose camera motion can
-# be verified: under it the texture is under the noise, and a shift the correlation finds is no proof
+REGISTRABLE = 0.25  # the best texture match with the reference frame (see _texture_match; in place,
+# or moved by the shift found) over the last checks, of a wall whose camera motion can be verified: under it the texture is under the
+# noise, and a shift the correlation finds is no proof
 NOT_REFUSED = ("motion not verifiable",)  # issues that say what could not be checked; answers stand
 
 KINDS = {
@@ -255,6 +258,25 @@ def _relative_texture(small: np.ndarray, fine: np.ndarray) -> np.ndarray:
     return np.where(edge.astype(bool), np.float32(np.nan), fine / level)
 
 
+def _in_band(hp: np.ndarray, small: np.ndarray, fine: np.ndarray, rel: np.ndarray) -> np.ndarray:
+    """The registration band ``hp`` relative to the local level, unknown where ``rel`` (the
+    relative texture) is: what camera motion is verified on, the band the shift was found in
+    (a wall's finest texture is what a codec keeps least)."""
+    return np.where(np.isfinite(rel), hp / np.maximum(small - fine, 1.0), np.float32(np.nan)).astype(np.float32)
+
+
+def _warp_texture(tex: np.ndarray, dx: float, dy: float) -> np.ndarray:
+    """``tex`` moved by (dx, dy) pixels; NaN (unknown) where any unknown or outside pixel enters."""
+    import cv2
+
+    known = np.isfinite(tex)
+    m = np.float32([[1, 0, dx], [0, 1, dy]])
+    size = tex.shape[::-1]
+    moved = cv2.warpAffine(np.where(known, tex, 0.0).astype(np.float32), m, size, flags=cv2.INTER_LINEAR)
+    ok = cv2.warpAffine(known.astype(np.float32), m, size, flags=cv2.INTER_LINEAR, borderValue=0.0) > 0.999
+    return np.where(ok, moved, np.float32(np.nan))
+
+
 def _broad_blur(img: np.ndarray, sigma: float) -> np.ndarray:
     """A Gaussian blur of large ``sigma`` computed at a quarter of the size (what it keeps has no
     detail finer than that) and brought back bilinearly: a tenth of the cost of the full kernel."""
@@ -305,6 +327,7 @@ class ViewCheck:
         self._bad = None
         self._bad_geometry = None
         self._tex = self._bg_c = None  # the wall's relative texture and colour ratios (see _objects)
+        self._ref_rel = None  # the reference frame's relative texture (see _texture_match)
         self._match: deque = deque(maxlen=HISTORY)  # _texture_match on checked frames without motion
         self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
         self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
@@ -469,6 +492,7 @@ class ViewCheck:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
         self._tex = _relative_texture(small, self._bg_h)
+        self._ref_rel = _in_band(hp, small, self._bg_h, self._tex)
         self._bg_c = self._chroma(planes, blocks, full)
         self._bg_n = 1
 
@@ -535,17 +559,28 @@ class ViewCheck:
         broad = dev > np.maximum(K_MOVER * sigma, REL * level)
         fine = _highpass(small, FINE)
         rel = _relative_texture(small, fine)
-        match = self._texture_match(rel, self._pixels(ok & ~broad, rel.shape))
-        usual = statistics.median(self._match) if self._match else None
-        registrable = usual is not None and usual >= REGISTRABLE
-        if moved and registrable and match is not None and match >= usual / 2:
-            moved = False  # a moving edge of light (the correlation locked on it), not the camera
-            self._shifts[-1] = (np.inf, np.inf)
-        if moved and not registrable:
-            flags.add("motion not verifiable")
-        elif moved:
-            flags.add("camera motion")
-            self.max_shift = max(self.max_shift, shift)
+        still = self._pixels(ok & ~broad, rel.shape)
+        reg = _in_band(hp, small, fine, rel)
+        match = self._texture_match(reg, self._ref_rel, still)
+        if moved:
+            # the camera moved by the shift if the reference's texture fits better moved by it
+            # than where it was: a moving edge of light that the correlation locked on leaves it
+            # where it was, and so does a re-coded (intra) frame, which only lowers both
+            shifted = self._texture_match(reg, _warp_texture(self._ref_rel, dx, dy), still)
+            found = [x for x in (match, shifted) if x is not None]
+            if found:
+                self._match.append(max(found))
+            # the wall is registrable if its texture matched the reference (in place or moved
+            # by the shift found) well enough at some check: a shaking camera seldom comes back
+            registrable = bool(self._match) and max(self._match) >= REGISTRABLE
+            if not registrable:
+                flags.add("motion not verifiable")
+            elif shifted is not None and match is not None and shifted > match:
+                flags.add("camera motion")
+                self.max_shift = max(self.max_shift, shift)
+            else:
+                moved = False
+                self._shifts[-1] = (np.inf, np.inf)
         elif match is not None:
             self._match.append(match)
         # something in view: a block far brighter or darker than its slow background (beyond
@@ -597,14 +632,15 @@ class ViewCheck:
             self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c).astype(np.float32)
         return flags
 
-    def _texture_match(self, rel: np.ndarray, where: np.ndarray) -> float | None:
-        """The regression of this frame's relative texture on the learnt one, over ``where``
-        (pixels; edges left out): about 1 on a still wall whose texture (or, compressed, frozen
-        noise) is far above its noise, and falling to 0 as the camera moves it away."""
-        m = where & np.isfinite(rel) & np.isfinite(self._tex)
+    @staticmethod
+    def _texture_match(rel: np.ndarray, ref: np.ndarray, where: np.ndarray) -> float | None:
+        """The regression of this frame's relative texture on the reference frame's, over
+        ``where`` (pixels; edges left out): near 1 on a still wall whose texture (or, compressed,
+        the noise the codec froze) is far above its noise, falling to 0 as the camera moves."""
+        m = where & np.isfinite(rel) & np.isfinite(ref)
         if np.count_nonzero(m) < 64:
             return None
-        x, y = rel[m], self._tex[m]
+        x, y = rel[m], ref[m]
         yy = float(np.dot(y, y))
         return float(np.dot(x, y)) / yy if yy > 0 else None
 
@@ -690,8 +726,9 @@ class ViewCheck:
             b, se = beta(region)
             lost = registrable and b < KEPT * b0 and (KEPT * b0 - b) > K_TEX * se
             flat = e0 > 0.0 and float(np.percentile(energy[region], FLAT_SHARE)) < FLAT * e0
-            colour = chroma is not None and int(region.sum()) >= COLOUR_BLOCKS and float(np.median(
-                np.hypot(*(chroma[:, region] - self._bg_c[:, region])))) > COLOUR
+            lit = region & (self._bg_b >= COLOUR_LEVEL)  # darker, a ratio is its quantisation and noise
+            colour = chroma is not None and int(lit.sum()) >= COLOUR_BLOCKS and float(np.median(
+                np.hypot(*(chroma[:, lit] - self._bg_c[:, lit])))) > COLOUR
             if self.trace is not None:
                 self.trace.append({"t": round(t, 3), "blocks": int(region.sum()), "hits": int((hit & region).sum()),
                                    "beta": b, "se": se, "beta_calm": b0, "se_calm": se0,
