@@ -328,7 +328,11 @@ class ViewCheck:
         self._bad_geometry = None
         self._tex = self._bg_c = None  # the wall's relative texture and colour ratios (see _objects)
         self._ref_rel = None  # the reference frame's relative texture (see _texture_match)
-        self._match: deque = deque(maxlen=HISTORY)  # _texture_match on checked frames without motion
+        # _texture_match on checked frames (the better of in place and moved by a shift found), in
+        # the registration band and in the finest one
+        self._match: deque = deque(maxlen=HISTORY)
+        self._match_fine: deque = deque(maxlen=HISTORY)
+        self._ref_fine = None
         self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
         self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
 
@@ -493,6 +497,7 @@ class ViewCheck:
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
         self._tex = _relative_texture(small, self._bg_h)
         self._ref_rel = _in_band(hp, small, self._bg_h, self._tex)
+        self._ref_fine = self._tex
         self._bg_c = self._chroma(planes, blocks, full)
         self._bg_n = 1
 
@@ -560,29 +565,36 @@ class ViewCheck:
         fine = _highpass(small, FINE)
         rel = _relative_texture(small, fine)
         still = self._pixels(ok & ~broad, rel.shape)
-        reg = _in_band(hp, small, fine, rel)
-        match = self._texture_match(reg, self._ref_rel, still)
+        # two bands: the finest texture tells small shifts apart best but is what a codec keeps
+        # least; the registration band (where the shift was found) is kept, but smooth
+        bands = ((rel, self._ref_fine, self._match_fine), (_in_band(hp, small, fine, rel), self._ref_rel, self._match))
+        matches = [self._texture_match(x, ref, still) for x, ref, _ in bands]
         if moved:
             # the camera moved by the shift if the reference's texture fits better moved by it
             # than where it was: a moving edge of light that the correlation locked on leaves it
             # where it was, and so does a re-coded (intra) frame, which only lowers both
-            shifted = self._texture_match(reg, _warp_texture(self._ref_rel, dx, dy), still)
-            found = [x for x in (match, shifted) if x is not None]
-            if found:
-                self._match.append(max(found))
-            # the wall is registrable if its texture matched the reference (in place or moved
-            # by the shift found) well enough at some check: a shaking camera seldom comes back
-            registrable = bool(self._match) and max(self._match) >= REGISTRABLE
-            if not registrable:
+            verdict = None
+            for (x, ref, history), match in zip(bands, matches):
+                shifted = self._texture_match(x, _warp_texture(ref, dx, dy), still)
+                found = [v for v in (match, shifted) if v is not None]
+                if found:
+                    history.append(max(found))
+                # registrable if the texture matched the reference (in place or moved by the
+                # shift found) well enough at some check: a shaking camera seldom comes back
+                if verdict is None and history and max(history) >= REGISTRABLE:
+                    verdict = shifted is not None and match is not None and shifted > match
+            if verdict is None:
                 flags.add("motion not verifiable")
-            elif shifted is not None and match is not None and shifted > match:
+            elif verdict:
                 flags.add("camera motion")
                 self.max_shift = max(self.max_shift, shift)
             else:
                 moved = False
                 self._shifts[-1] = (np.inf, np.inf)
-        elif match is not None:
-            self._match.append(match)
+        else:
+            for (_, _, history), match in zip(bands, matches):
+                if match is not None:
+                    history.append(match)
         # something in view: a block far brighter or darker than its slow background (beyond
         # the noise and beyond any hidden person's few per cent) whose fine structure changed
         # too (an object's outline), by a fair part of the step it bounds (SHARP); a hidden
