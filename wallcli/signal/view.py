@@ -80,6 +80,8 @@ CHECK_RATE = 3.0  # frames checked per second of a calm view: checking every fra
 # for DENSE seconds, so the rules that ask for agreement between neighbouring frames (a shake's
 # shifts) and a mover's outline get every frame's chance, as before
 DENSE = 0.5
+MATCH_RATE = 1.0  # checks a second that learn the texture and colour and measure how registrable the
+# wall is (see REGISTRABLE): each is a few tenths of a ms, and light and texture change slowly
 
 TEX_TAU = 4.0  # seconds: the wall's texture is learnt where nothing changed, over this time
 EDGE_GRAD = 0.02  # of the level a pixel, at the outline's scale FINE: a step of 10 % (a wall's texture
@@ -333,6 +335,7 @@ class ViewCheck:
         self._match: deque = deque(maxlen=HISTORY)
         self._match_fine: deque = deque(maxlen=HISTORY)
         self._ref_fine = None
+        self._t_tex = self._t_match = -np.inf
         self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
         self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
 
@@ -500,6 +503,9 @@ class ViewCheck:
         self._ref_fine = self._tex
         self._bg_c = self._chroma(planes, blocks, full)
         self._bg_n = 1
+        self._t_tex = self._t_match = self._t_checked
+        self._match.clear()  # a new view (a cut): how registrable it is is its own
+        self._match_fine.clear()
 
     def _changes(self, t, blocks, hp, ok, small, clipped, planes, full) -> set:
         import cv2
@@ -563,38 +569,6 @@ class ViewCheck:
         dev = np.abs(blocks - g * self._bg_b)
         broad = dev > np.maximum(K_MOVER * sigma, REL * level)
         fine = _highpass(small, FINE)
-        rel = _relative_texture(small, fine)
-        still = self._pixels(ok & ~broad, rel.shape)
-        # two bands: the finest texture tells small shifts apart best but is what a codec keeps
-        # least; the registration band (where the shift was found) is kept, but smooth
-        bands = ((rel, self._ref_fine, self._match_fine), (_in_band(hp, small, fine, rel), self._ref_rel, self._match))
-        matches = [self._texture_match(x, ref, still) for x, ref, _ in bands]
-        if moved:
-            # the camera moved by the shift if the reference's texture fits better moved by it
-            # than where it was: a moving edge of light that the correlation locked on leaves it
-            # where it was, and so does a re-coded (intra) frame, which only lowers both
-            verdict = None
-            for (x, ref, history), match in zip(bands, matches):
-                shifted = self._texture_match(x, _warp_texture(ref, dx, dy), still)
-                found = [v for v in (match, shifted) if v is not None]
-                if found:
-                    history.append(max(found))
-                # registrable if the texture matched the reference (in place or moved by the
-                # shift found) well enough at some check: a shaking camera seldom comes back
-                if verdict is None and history and max(history) >= REGISTRABLE:
-                    verdict = shifted is not None and match is not None and shifted > match
-            if verdict is None:
-                flags.add("motion not verifiable")
-            elif verdict:
-                flags.add("camera motion")
-                self.max_shift = max(self.max_shift, shift)
-            else:
-                moved = False
-                self._shifts[-1] = (np.inf, np.inf)
-        else:
-            for (_, _, history), match in zip(bands, matches):
-                if match is not None:
-                    history.append(match)
         # something in view: a block far brighter or darker than its slow background (beyond
         # the noise and beyond any hidden person's few per cent) whose fine structure changed
         # too (an object's outline), by a fair part of the step it bounds (SHARP); a hidden
@@ -618,24 +592,70 @@ class ViewCheck:
         # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
         # rules above never see them, as clipped blocks are not 'ok'
         covered = broad & clipped & (g * self._bg_b * (1 + 2 * REL) < CLIP_HI)
+        # the texture relative to the level (which light does not change), where it is needed:
+        # to verify a shift, to judge an outline, and a few times a second to learn it (the
+        # checks in between, every frame after anything suspect, do without: it is most of the
+        # check's cost on a wall with moving shadows)
+        learn_due = t - self._t_tex >= 1.0 / MATCH_RATE - 1e-3
+        history_due = t - self._t_match >= 1.0 / MATCH_RATE - 1e-3
+        outlined = not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS
+        rel = _relative_texture(small, fine) if moved or outlined or learn_due or history_due else None
+        if moved or history_due:
+            still = self._pixels(ok & ~broad, rel.shape)
+            # two bands: the finest texture tells small shifts apart best but is what a codec keeps
+            # least; the registration band (where the shift was found) is kept, but smooth
+            bands = ((rel, self._ref_fine, self._match_fine), (_in_band(hp, small, fine, rel), self._ref_rel, self._match))
+            matches = [self._texture_match(x, ref, still) for x, ref, _ in bands]
+            if moved:
+                # the camera moved by the shift if the reference's texture fits better moved by it
+                # than where it was: a moving edge of light that the correlation locked on leaves it
+                # where it was, and so does a re-coded (intra) frame, which only lowers both
+                verdict = None
+                for (x, ref, history), match in zip(bands, matches):
+                    shifted = self._texture_match(x, _warp_texture(ref, dx, dy), still)
+                    found = [v for v in (match, shifted) if v is not None]
+                    if found:
+                        history.append(max(found))
+                    # registrable if the texture matched the reference (in place or moved by the
+                    # shift found) well enough at some check: a shaking camera seldom comes back
+                    if verdict is None and history and max(history) >= REGISTRABLE:
+                        verdict = shifted is not None and match is not None and shifted > match
+                if verdict is None:
+                    flags.add("motion not verifiable")
+                elif verdict:
+                    flags.add("camera motion")
+                    self.max_shift = max(self.max_shift, shift)
+                else:
+                    moved = False
+                    self._shifts[-1] = (np.inf, np.inf)
+            elif history_due:
+                self._t_match = t
+                for (_, _, history), match in zip(bands, matches):
+                    if match is not None:
+                        history.append(match)
         # the outline says only that the change is sharp; whether it is light or a thing is read
         # inside it, on the wall's texture relative to its level (which light does not change)
-        ratio = blocks / np.maximum(g * self._bg_b, 1e-3)
-        chroma = self._chroma(planes, blocks, full) if self._bg_c is not None else None
+        chroma = self._chroma(planes, blocks, full) if self._bg_c is not None and (outlined or learn_due) else None
+        judged = hit
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
-            hit = self._objects(t, hit, broad & ok, ok, rel, ratio, chroma)
-        hit |= covered
-        if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
+            ratio = blocks / np.maximum(g * self._bg_b, 1e-3)
+            judged = self._objects(t, hit, broad & ok, ok, rel, ratio, chroma)
+        judged = judged | covered
+        if not moved and int(judged.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
-            self._bad |= hit
-        if suspect or moved or (broad & ok).any() or covered.any():
+            self._bad |= judged
+        # every frame for a while after anything suspect; a sharp change of light is not
+        if suspect or moved or judged.any() or ((broad & ok).any() and not outlined):
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
         # the wall's texture: learnt where nothing changed, slower than the background (a shadow
         # that stays is learnt through, an object that stops is learnt like the background)
+        if not learn_due:
+            return flags
         calm = self._pixels(~broad & ok, rel.shape)
-        b = max(1.0 - np.exp(-max(t - self._t_prev, 1e-3) / TEX_TAU), 1.0 / self._bg_n)
+        b = max(1.0 - np.exp(-max(t - self._t_tex, 1e-3) / TEX_TAU), 1.0 / self._bg_n)
+        self._t_tex = t
         tex = self._tex
         learn = calm & np.isfinite(rel)  # an unknown pixel (an edge) keeps what was learnt
         self._tex = np.where(learn, np.where(np.isfinite(tex), (1 - b) * tex + b * rel, rel), tex).astype(np.float32)
