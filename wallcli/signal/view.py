@@ -107,8 +107,9 @@ FLAT, FLAT_SHARE = 0.02, 10
 COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL = 0.1, 4, 60.0
 NOTES = {"sharp light": "sharp shadow or light in view: a person near the wall or a small light"}
 
-REGISTRABLE = 0.25  # the best texture match with the reference frame (see _texture_match; in place,
-# or moved by the shift found) over the last checks, of a wall whose camera motion can be verified: under it the texture is under the
+REGISTRABLE = 8.0  # standard errors: the best texture match with the reference frame (see
+# _texture_match; in place, or moved by the shift found) over the last checks, of a wall whose
+# camera motion can be verified: under it the texture is under the
 # noise, and a shift the correlation finds is no proof
 NOT_REFUSED = ("motion not verifiable",)  # issues that say what could not be checked; answers stand
 
@@ -503,7 +504,7 @@ class ViewCheck:
         self._ref_fine = self._tex
         self._bg_c = self._chroma(planes, blocks, full)
         self._bg_n = 1
-        self._t_tex = self._t_match = self._t_checked
+        self._t_tex, self._t_match = self._t_checked, -np.inf  # how registrable: from the next check
         self._match.clear()  # a new view (a cut): how registrable it is is its own
         self._match_fine.clear()
 
@@ -667,14 +668,21 @@ class ViewCheck:
     @staticmethod
     def _texture_match(rel: np.ndarray, ref: np.ndarray, where: np.ndarray) -> float | None:
         """The regression of this frame's relative texture on the reference frame's, over
-        ``where`` (pixels; edges left out): near 1 on a still wall whose texture (or, compressed,
-        the noise the codec froze) is far above its noise, falling to 0 as the camera moves."""
+        ``where`` (pixels; edges left out), in standard errors: large on a still wall with
+        texture (or, compressed, noise the codec froze) that registers, falling to 0 as the
+        camera moves it away."""
         m = where & np.isfinite(rel) & np.isfinite(ref)
         if np.count_nonzero(m) < 64:
             return None
         x, y = rel[m], ref[m]
         yy = float(np.dot(y, y))
-        return float(np.dot(x, y)) / yy if yy > 0 else None
+        if yy <= 0:
+            return None
+        b = float(np.dot(x, y)) / yy
+        resid = max(float(np.dot(x, x)) - b * b * yy, 0.0) / x.size
+        # in standard errors (pixels counted a quarter, as in _objects): a wall's texture can be
+        # a small share of each pixel and still register over the whole frame
+        return b / max(float(np.sqrt(4.0 * resid / yy)), 1e-12)
 
     @staticmethod
     def _pixels(mask: np.ndarray, shape) -> np.ndarray:
