@@ -268,6 +268,12 @@ def _in_band(hp: np.ndarray, small: np.ndarray, fine: np.ndarray, rel: np.ndarra
     return np.where(np.isfinite(rel), hp / np.maximum(small - fine, 1.0), np.float32(np.nan)).astype(np.float32)
 
 
+def _rms_known(a: np.ndarray) -> float:
+    """RMS of the finite values of ``a``; infinite (no bound) when there are none."""
+    a = a[np.isfinite(a)]
+    return float(np.sqrt(np.mean(a * a))) if a.size else np.inf
+
+
 def _warp_texture(tex: np.ndarray, dx: float, dy: float) -> np.ndarray:
     """``tex`` moved by (dx, dy) pixels; NaN (unknown) where any unknown or outside pixel enters."""
     import cv2
@@ -733,7 +739,7 @@ class ViewCheck:
         # as texture lost; pixels far out in either are left out (the wall's texture is a few
         # per cent with a Gaussian's tails)
         pc = self._pixels(calm, rel.shape)
-        sx, sm = (float(np.sqrt(np.nanmean(a[pc] ** 2))) if pc.any() else np.inf for a in (rel, tex))
+        sx, sm = (_rms_known(a[pc]) for a in (rel, tex))
         with np.errstate(invalid="ignore"):
             keep = (np.abs(rel) < K_OUTLIER * sx) & (np.abs(tex) < K_OUTLIER * sm)  # NaN: no
         r, m = np.where(keep, rel, 0.0).astype(np.float32), np.where(keep, tex, 0.0).astype(np.float32)
