@@ -97,20 +97,24 @@ K_OUTLIER = 3.0  # RMS of the calm blocks: beyond it a pixel of either texture i
 #   energy (at their level): neither the wall's texture nor the noise that light brings;
 # - its colour ratios moved by over COLOUR (on COLOUR_BLOCKS blocks or more, of a background level
 #   of COLOUR_LEVEL or more: a small deep shadow under two lights of other colours moved them by up
-#   to 0.25, and on a wall of level 30 a ratio's quantisation alone is 0.03).
-# Chosen on session 19's first 16 rounds (research/view/README.md): no wall's region was either;
-# COLOUR_LEVEL after the first held-out false alarm (a wall of level 30).
+#   to 0.25, a shadow taking half the light of a room lit in two colours by 0.10, and on a wall of
+#   level 30 a ratio's quantisation alone is 0.03). On the simulator's objects it adds next to
+#   nothing to the two rules above; it is there for real objects on walls with no texture.
+# Chosen on session 19's first 16 rounds (research/view/README.md); COLOUR_LEVEL and COLOUR 0.15
+# after false alarms of the whole sample were seen (walls of level 30; the half-light shadow).
 MIN_KNOWN = 4
 KEPT = 0.1
 K_TEX = 4.0
 FLAT, FLAT_SHARE = 0.02, 10
-COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL = 0.1, 4, 60.0
+COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL = 0.15, 4, 60.0
 NOTES = {"sharp light": "sharp shadow or light in view: a person near the wall or a small light"}
 
 REGISTRABLE = 8.0  # standard errors: the best texture match with the reference frame (see
 # _texture_match; in place, or moved by the shift found) over the last checks, of a wall whose
 # camera motion can be verified: under it the texture is under the
 # noise, and a shift the correlation finds is no proof
+SHIFT_Z = 3.0  # standard errors by which the reference moved by the shift must fit better than in place
+# (session 19: four still walls had the finest band's two within 0.3-1.5 and the other band's reversed)
 NOT_REFUSED = ("motion not verifiable",)  # issues that say what could not be checked; answers stand
 
 KINDS = {
@@ -624,9 +628,11 @@ class ViewCheck:
                     if found:
                         history.append(max(found))
                     # registrable if the texture matched the reference (in place or moved by the
-                    # shift found) well enough at some check: a shaking camera seldom comes back
-                    if verdict is None and history and max(history) >= REGISTRABLE:
-                        verdict = shifted is not None and match is not None and shifted > match
+                    # shift found) well enough at some check: a shaking camera seldom comes back;
+                    # every band that is must agree, each by SHIFT_Z
+                    if history and max(history) >= REGISTRABLE:
+                        agrees = shifted is not None and match is not None and shifted - match > SHIFT_Z
+                        verdict = agrees if verdict is None else verdict and agrees
                 if verdict is None:
                     flags.add("motion not verifiable")
                 elif verdict:
