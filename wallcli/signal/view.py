@@ -792,7 +792,7 @@ class ViewCheck:
                                    "e0": e0, "known": float(known[region].sum()) / (side * side),
                                    "colour_calm": None if chroma is None or not calm.any() else float(np.median(
                                        np.hypot(*(chroma[:, calm] - self._bg_c[:, calm])))),
-                                   "level": float(np.median(ratio[region] * 0 + (self._bg_b[region])))})
+                                   "level": float(np.median(self._bg_b[region]))})
             if lost or flat or colour:
                 out |= hit & region
             else:
