@@ -281,3 +281,76 @@ def test_answers_from_a_plot_carry_the_videos_view(run_cli, crossing, tmp_path):
     for cmd in ("count", "activity"):
         code, out, err = run_cli(cmd, npz, "--strict")
         assert code == 1 and out == "" and "moving object" in err
+def _shadow_clip(path, kind: str, n: int = 90):
+    """A textured wall (4 %, colour (180, 150, 120)) with a sharp ellipse crossing it: 'shadow'
+    dims the wall under it to 60 % (its texture, fixed pattern and colour ratios stay), 'object'
+    puts a flat grey of the same luma there (hiding the texture), 'textured' an object with a
+    texture of its own."""
+    import cv2
+
+    from clips import write_clip
+
+    h, w = 240, 320
+    rng = np.random.default_rng(1)
+    texture = 1 + 0.04 * rng.standard_normal((h, w)).astype(np.float32)
+    own = 1 + 0.06 * rng.standard_normal((h, w)).astype(np.float32)
+    colour = np.array([180.0, 150.0, 120.0])
+
+    def frame(i):
+        m = np.zeros((h, w), np.float32)
+        cv2.ellipse(m, (int(-60 + i * (w + 120) / n), h // 2), (40, 90), 0, 0, 360, 1.0, -1)
+        m = cv2.GaussianBlur(m, (0, 0), 0.7)[..., None]
+        wall = colour * texture[..., None]
+        if kind == "shadow":
+            img = wall * (1 - 0.4 * m)
+        else:
+            luma = 0.6 * float(colour @ [0.299, 0.587, 0.114])
+            obj = np.full(3, luma) * (own[..., None] if kind == "textured" else 1.0)
+            img = wall * (1 - m) + obj * m
+        return img + rng.normal(0, 1.0, (h, w, 3))
+
+    return write_clip(path, frame, n, options={"crf": "18", "preset": "medium"})
+
+
+def test_a_sharp_shadow_is_a_note_and_an_object_in_its_place_is_refused(tmp_path):
+    """Issue 36: a change of light (the wall's texture, fixed pattern and colour ratios still
+    there) is no view fault, however sharp: the view stays usable, with a note. An object of the
+    same shape and luma that hides the texture, flat or with a texture of its own, stays refused.
+    Before session 19 the shadow was refused as a moving object."""
+    shadow = _check(_shadow_clip(tmp_path / "s.mp4", "shadow"))
+    assert shadow["usable"] and shadow["issues"] == [], shadow
+    assert any(n.startswith("sharp shadow or light in view") for n in shadow["notes"]), shadow
+    for kind in ("object", "textured"):
+        obj = _check(_shadow_clip(tmp_path / f"{kind}.mp4", kind))
+        assert not obj["usable"] and "moving object" in obj["issues"], (kind, obj)
+
+
+def test_a_camera_that_moves_over_a_wall_with_nothing_to_register_on_is_not_verifiable():
+    """Issue 36: where the wall has no texture to register on, a shift the correlation finds is
+    no proof: 'motion not verifiable', which does not make the view unusable (answers stand)."""
+    from wallcli.signal.view import NOT_REFUSED, ViewCheck
+
+    vc = ViewCheck()
+    vc.frames = 1
+    vc._mark("motion not verifiable", 1.0)
+    view = vc.view()
+    assert "motion not verifiable" in NOT_REFUSED
+    assert view["usable"] and view["issues"] == ["motion not verifiable"] and view["reason"] is None
+    assert any("whether the camera moved is not known" in n for n in view["notes"])
+    vc._mark("camera motion", 2.0)
+    assert not vc.view()["usable"] and vc.view()["reason"].startswith("not a static view of the wall: camera motion")
+
+
+def test_a_clip_too_short_for_a_window_gets_the_files_frames_and_a_view(run_cli, tmp_path):
+    """Issue 36: 'too short' quoted the frames resampled to the model's rate and said nothing of
+    the view; it now quotes the file's frames at the file's rate and the view's verdict."""
+    from clips import write_clip
+
+    rng = np.random.default_rng(0)
+    clip = write_clip(tmp_path / "short.mp4", lambda i: np.full((48, 64, 3), 120.0) + rng.normal(0, 2, (48, 64, 3)),
+                      45, fps=25)
+    for cmd in ("count", "activity"):
+        code, out, err = run_cli(cmd, clip, "--json")
+        assert code == 1 and out == ""
+        line = [x for x in err.splitlines() if x.strip()][0]
+        assert "45 frame(s) at 25 fps (1.80 s)" in line and "view: usable" in line, line

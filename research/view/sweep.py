@@ -25,7 +25,11 @@ import numpy as np
 
 SECONDS, FPS = 4.0, 30.0
 N = int(SECONDS * FPS)
-SLOTS = (("room", "base"), ("room", "shifted"), ("room", "wide"), ("room", "steady"), ("flatland", None))
+SLOTS = (("room", "base"), ("room", "shifted"), ("room", "wide"), ("room", "steady"), ("flatland", None),
+         # session 19: sharp shadows: people 0.3-1.5 m from the wall (any room domain in turn), and the
+         # bundled examples' camera (160x120, crf 12, lamps or windows, people 1-2 m away)
+         ("room", "near"), ("room", "example"))
+NEAR_DOMAINS = ("base", "wide", "steady", "shifted")
 PANS = (2.0, 3.0, 4.0, 6.0, 10.0)  # px in total over 1-3 s
 SHAKES = (0.5, 1.0, 1.5, 2.0, 3.0)  # px rms per axis
 
@@ -44,8 +48,15 @@ def wall_frames(seed: int, world: str, domain: str) -> list:
         return list(s.frames())
     from wallcli.sim.scene import SceneConfig, sample_scene
 
-    cfg = SceneConfig(people=people, duration=SECONDS, fps=FPS, width=320, height=240, domain=domain,
-                      codec="libx264", crf=18, nuisance_p=0.5)
+    if domain == "example":  # as examples/make_examples.sh makes them
+        cfg = SceneConfig(people=max(people, 1), duration=SECONDS, fps=FPS, width=160, height=120, domain="base",
+                          codec="libx264", crf=12, distance=(1.0, 2.0), nuisance_p=0.5,
+                          camera_overrides={"gain": 0.1, "read_noise": 1.5, "sensor_pixels": 200000.0})
+        return list(sample_scene(seed, cfg).frames())
+    near = domain.startswith("near")
+    cfg = SceneConfig(people=max(people, 1) if near else people, duration=SECONDS, fps=FPS, width=320, height=240,
+                      domain=domain.split("-")[1] if near else domain, codec="libx264", crf=18, nuisance_p=0.5,
+                      **({"distance": (0.3, 1.5)} if near else {}))
     return list(sample_scene(seed, cfg).frames())
 
 
@@ -60,6 +71,8 @@ def make(a) -> None:
     for k in range(a.start, a.start + a.rounds):
         for j, (world, dom) in enumerate(SLOTS):
             dom = dom or ("base", "wide")[k % 2]
+            if dom == "near":
+                dom = "near-" + NEAR_DOMAINS[k % len(NEAR_DOMAINS)]
             seed = a.seed + 10 * k + j
             frames = wall_frames(seed, world, dom)
             # the cut goes to the previous round's wall of the slot (a fresh one in the first round)

@@ -33,6 +33,25 @@ def _too_short(source: str, frames: int, model, fps: float | None = None) -> Wal
         f"one window needs {model.window} frames at {model.fps:g} fps ({model.window / model.fps:.2f} s)")
 
 
+def _too_short_video(source: str, check, model) -> WallcliError:
+    """The too-short error of a video: the frames quoted are the file's (not the rows resampled to
+    the model's rate), and the view check's verdict on them goes with it (``view`` on the error,
+    and in its line): a clip too short to answer may still be no view of a wall."""
+    n, fps = check.seen, check.fps
+    view = check.summary()
+    said = "usable" if view["usable"] else view["reason"]
+    need = f"{model.window / model.fps:.2f} s"
+    if fps:
+        need = f"{int(np.ceil(model.window / model.fps * fps - 1e-6))} frames ({need})"
+        exc = WallcliError(f"{source} is too short: {n} frame(s) at {fps:g} fps ({n / fps:.2f} s); "
+                           f"one window needs {need}; view: {said}")
+    else:
+        exc = WallcliError(f"{source} is too short: {n} frame(s); one window needs {need}; view: {said}")
+    exc.view = view
+    return exc
+
+
+
 def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None]:
     block = model.card.get("confidence")
     confident, reason = judge(block, probs, signal_db, model.classes)
@@ -289,6 +308,9 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             if thumb is not None:
                 thumb.push(t, row)
             classifier.push(t, stream_row(row, rows), rows.ref)
+        if classifier.windower.last() is None:
+            check.fps = float(reader.info.fps or 0.0) or None
+            raise _too_short_video(str(source), check, model)
     result = with_view(classifier.result(str(source), frames=rows.frames), check)
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
@@ -351,5 +373,6 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
                                                options=corrections)
                 rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
                 yield judge_view(rec, check.view(rec["start"], rec["end"]))
-    if windower.count < model.window:
-        raise _too_short(str(source), rows.frames, model, float(reader.info.fps))
+        if windower.count < model.window:
+            check.fps = float(reader.info.fps or 0.0) or None
+            raise _too_short_video(str(source), check, model)

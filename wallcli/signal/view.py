@@ -82,9 +82,46 @@ CHECK_RATE = 3.0  # frames checked per second of a calm view: checking every fra
 # for DENSE seconds, so the rules that ask for agreement between neighbouring frames (a shake's
 # shifts) and a mover's outline get every frame's chance, as before
 DENSE = 0.5
+MATCH_RATE = 1.0  # checks a second that learn the texture and colour and measure how registrable the
+# wall is (see REGISTRABLE): each is a few tenths of a ms, and light and texture change slowly
+
+TEX_TAU = 4.0  # seconds: the wall's texture is learnt where nothing changed, over this time
+EDGE_GRAD = 0.02  # of the level a pixel, at the outline's scale FINE: a step of 10 % (a wall's texture
+# of a few per cent a pixel, blurred by FINE, stayed under 0.9 % on the bundled examples)
+K_OUTLIER = 3.0  # RMS of the calm blocks: beyond it a pixel of either texture is an edge, not texture
+# A region is an object when (any of):
+# - the wall's texture is gone: its regression on the learnt texture is under KEPT of the calm
+#   blocks' by K_TEX standard errors (with MIN_KNOWN blocks' worth of pixels that are no edge).
+#   Not a half: a compressed wall's calm blocks are copied from frame to frame, frozen noise and
+#   all, while the codec re-codes a moving shadow and keeps a tenth to a half of the texture there
+#   (sharp-shadow walls at CRF 18: 0.1-0.4; the same walls lossless: all of it);
+# - it is flat: FLAT_SHARE % of its blocks hold under FLAT of the calm blocks' relative fine
+#   energy (at their level): neither the wall's texture nor the noise that light brings;
+# - its colour ratios moved by over COLOUR (on COLOUR_BLOCKS blocks or more, of a background level
+#   of COLOUR_LEVEL or more: a small deep shadow under two lights of other colours moved them by up
+#   to 0.25, a shadow taking half the light of a room lit in two colours by 0.10, and on a wall of
+#   level 30 a ratio's quantisation alone is 0.03). On the simulator's objects it adds next to
+#   nothing to the two rules above; it is there for real objects on walls with no texture.
+# Chosen on session 19's first 16 rounds (research/view/README.md); COLOUR_LEVEL and COLOUR 0.15
+# after false alarms of the whole sample were seen (walls of level 30; the half-light shadow).
+MIN_KNOWN = 4
+KEPT = 0.1
+K_TEX = 4.0
+FLAT, FLAT_SHARE = 0.02, 10
+COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL = 0.15, 4, 60.0
+NOTES = {"sharp light": "sharp shadow or light in view: a person near the wall or a small light"}
+
+REGISTRABLE = 8.0  # standard errors: the best texture match with the reference frame (see
+# _texture_match; in place, or moved by the shift found) over the last checks, of a wall whose
+# camera motion can be verified: under it the texture is under the
+# noise, and a shift the correlation finds is no proof
+SHIFT_Z = 3.0  # standard errors by which the reference moved by the shift must fit better than in place
+# (session 19: four still walls had the finest band's two within 0.3-1.5 and the other band's reversed)
+NOT_REFUSED = ("motion not verifiable",)  # issues that say what could not be checked; answers stand
 
 KINDS = {
     "camera motion": "the camera moved",
+    "motion not verifiable": "the wall has no texture to register on: whether the camera moved is not known",
     "moving object": "something moved in view",
     "scene cut": "the shot changes",
     "clipped": "much of the frame is clipped",
@@ -220,6 +257,45 @@ def _highpass(img: np.ndarray, sigma: float = 4.0) -> np.ndarray:
     return img - cv2.GaussianBlur(img, (0, 0), sigma)
 
 
+def _relative_texture(small: np.ndarray, fine: np.ndarray) -> np.ndarray:
+    """The fine band relative to the local level: what a change of light leaves as it is (texture,
+    fixed pattern). Where the level itself changes fast (an edge of light, over EDGE_GRAD of the
+    level a pixel) it is NaN, unknown: the edge is no texture."""
+    import cv2
+
+    low = small - fine
+    level = np.maximum(low, 1.0)
+    gx = cv2.Sobel(low, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(low, cv2.CV_32F, 0, 1, ksize=3)
+    edge = cv2.dilate(((gx * gx + gy * gy) > (8.0 * EDGE_GRAD * level) ** 2).astype(np.uint8), np.ones((3, 3), np.uint8))
+    return np.where(edge.astype(bool), np.float32(np.nan), fine / level)
+
+
+def _in_band(hp: np.ndarray, small: np.ndarray, fine: np.ndarray, rel: np.ndarray) -> np.ndarray:
+    """The registration band ``hp`` relative to the local level, unknown where ``rel`` (the
+    relative texture) is: what camera motion is verified on, the band the shift was found in
+    (a wall's finest texture is what a codec keeps least)."""
+    return np.where(np.isfinite(rel), hp / np.maximum(small - fine, 1.0), np.float32(np.nan)).astype(np.float32)
+
+
+def _rms_known(a: np.ndarray) -> float:
+    """RMS of the finite values of ``a``; infinite (no bound) when there are none."""
+    a = a[np.isfinite(a)]
+    return float(np.sqrt(np.mean(a * a))) if a.size else np.inf
+
+
+def _warp_texture(tex: np.ndarray, dx: float, dy: float) -> np.ndarray:
+    """``tex`` moved by (dx, dy) pixels; NaN (unknown) where any unknown or outside pixel enters."""
+    import cv2
+
+    known = np.isfinite(tex)
+    m = np.float32([[1, 0, dx], [0, 1, dy]])
+    size = tex.shape[::-1]
+    moved = cv2.warpAffine(np.where(known, tex, 0.0).astype(np.float32), m, size, flags=cv2.INTER_LINEAR)
+    ok = cv2.warpAffine(known.astype(np.float32), m, size, flags=cv2.INTER_LINEAR, borderValue=0.0) > 0.999
+    return np.where(ok, moved, np.float32(np.nan))
+
+
 def _broad_blur(img: np.ndarray, sigma: float) -> np.ndarray:
     """A Gaussian blur of large ``sigma`` computed at a quarter of the size (what it keeps has no
     detail finer than that) and brought back bilinearly: a tenth of the cost of the full kernel."""
@@ -242,7 +318,9 @@ class ViewCheck:
 
     def __init__(self, roi=None) -> None:
         self.roi = roi  # (x, y, w, h): only what the analysis reads needs to be a still wall
-        self.frames = 0
+        self.frames = 0  # checked in full
+        self.seen = 0  # fed (every decoded frame)
+        self.fps: float | None = None  # the file's rate, where a caller that quotes frames sets it
         self.spans: dict[str, list[list[float]]] = {k: [] for k in KINDS}
         self.max_shift = 0.0
         self.min_usable = 1.0
@@ -267,6 +345,16 @@ class ViewCheck:
         # checked frames, and where those blocks lie in source pixels: what `snr --roi auto` avoids
         self._bad = None
         self._bad_geometry = None
+        self._tex = self._bg_c = None  # the wall's relative texture and colour ratios (see _objects)
+        self._ref_rel = None  # the reference frame's relative texture (see _texture_match)
+        # _texture_match on checked frames (the better of in place and moved by a shift found), in
+        # the registration band and in the finest one
+        self._match: deque = deque(maxlen=HISTORY)
+        self._match_fine: deque = deque(maxlen=HISTORY)
+        self._ref_fine = None
+        self._t_tex = self._t_match = -np.inf
+        self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
+        self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
 
     def __call__(self, frame) -> None:
         gap = getattr(frame, "gap", 0.0)
@@ -288,6 +376,7 @@ class ViewCheck:
         less than 1/CHECK_RATE s before (and nothing suspect was seen since)."""
         from wallcli.signal.blocks import one_opencv_thread
 
+        self.seen += 1
         # these images are too small for OpenCV's pool's hand-offs to pay (blocks.one_opencv_thread)
         with one_opencv_thread():
             cut = self._watch_cut(t, planes) if self._cut_t is None or t - self._cut_t >= 1.0 / CUT_RATE - 1e-3 else None
@@ -393,10 +482,10 @@ class ViewCheck:
         # registration reads a band: finer is mostly noise and codec residue, coarser is light
         hp = cv2.GaussianBlur(small, (0, 0), 1.5) - _broad_blur(small, 8.0)
         if self._prev_b is None or self._cut_reset:
-            self._reset(hp, small, blocks)
+            self._reset(hp, small, blocks, planes, full)
             self._cut_reset = False
         else:
-            flags |= self._changes(t, blocks, hp, ok, small, clipped)
+            flags |= self._changes(t, blocks, hp, ok, small, clipped, planes, full)
         self._prev_b, self._prev_h, self._t_prev = blocks, hp, t
         self.frames += 1
         for kind in flags:
@@ -434,12 +523,19 @@ class ViewCheck:
             out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
         return out
 
-    def _reset(self, hp, small, blocks) -> None:
+    def _reset(self, hp, small, blocks, planes, full) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
+        self._tex = _relative_texture(small, self._bg_h)
+        self._ref_rel = _in_band(hp, small, self._bg_h, self._tex)
+        self._ref_fine = self._tex
+        self._bg_c = self._chroma(planes, blocks, full)
         self._bg_n = 1
+        self._t_tex, self._t_match = self._t_checked, -np.inf  # how registrable: from the next check
+        self._match.clear()  # a new view (a cut): how registrable it is is its own
+        self._match_fine.clear()
 
-    def _changes(self, t, blocks, hp, ok, small, clipped) -> set:
+    def _changes(self, t, blocks, hp, ok, small, clipped, planes, full) -> set:
         import cv2
 
         flags = set()
@@ -500,23 +596,22 @@ class ViewCheck:
             self._shifts.append((dx, dy) if fits else (np.inf, np.inf))
         else:
             self._shifts.append((np.inf, np.inf))
-        if moved:
-            flags.add("camera motion")
-            self.max_shift = max(self.max_shift, shift)
+        # the wall's own texture, relative to its level, where nothing changed: still in its
+        # place (the learnt texture at no shift) if the camera did not move, whatever light did
+        a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
+        g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
+        dev = np.abs(blocks - g * self._bg_b)
+        broad = dev > np.maximum(K_MOVER * sigma, REL * level)
+        fine = _highpass(small, FINE)
         # something in view: a block far brighter or darker than its slow background (beyond
         # the noise and beyond any hidden person's few per cent) whose fine structure changed
         # too (an object's outline), by a fair part of the step it bounds (SHARP); a hidden
         # person's shadow, even a hard one from a window, has edges blurred by its penumbra and
         # changes the fine scale far less for its step
-        a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
         # until it has 2 s of frames, the background is their plain mean: one frame's noise (the
         # first is often the codec's intra frame, coded unlike the rest) is not the wall's
         self._bg_n += 1
         a = max(a, 1.0 / self._bg_n)
-        g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
-        dev = np.abs(blocks - g * self._bg_b)
-        broad = dev > np.maximum(K_MOVER * sigma, REL * level)
-        fine = _highpass(small, FINE)
         # light falling on the wall scales its texture with it: compare with the background's
         # texture scaled by each block's change of level, so a shadow's dimming is not an outline
         scale = cv2.resize(blocks / np.maximum(g * self._bg_b, 1.0), fine.shape[::-1], interpolation=cv2.INTER_LINEAR)
@@ -531,18 +626,209 @@ class ViewCheck:
         # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
         # rules above never see them, as clipped blocks are not 'ok'
         covered = broad & clipped & (g * self._bg_b * (1 + 2 * REL) < CLIP_HI)
-        hit |= covered
+        # the texture relative to the level (which light does not change), where it is needed:
+        # to verify a shift, to judge an outline, and a few times a second to learn it (the
+        # checks in between, every frame after anything suspect, do without: it is most of the
+        # check's cost on a wall with moving shadows)
+        learn_due = t - self._t_tex >= 1.0 / MATCH_RATE - 1e-3
+        history_due = t - self._t_match >= 1.0 / MATCH_RATE - 1e-3
+        outlined = not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS
+        rel = _relative_texture(small, fine) if moved or outlined or learn_due or history_due else None
+        if moved or history_due:
+            still = self._pixels(ok & ~broad, rel.shape)
+            # two bands: the finest texture tells small shifts apart best but is what a codec keeps
+            # least; the registration band (where the shift was found) is kept, but smooth
+            bands = ((rel, self._ref_fine, self._match_fine), (_in_band(hp, small, fine, rel), self._ref_rel, self._match))
+            matches = [self._texture_match(x, ref, still) for x, ref, _ in bands]
+            if moved:
+                # the camera moved by the shift if the reference's texture fits better moved by it
+                # than where it was: a moving edge of light that the correlation locked on leaves it
+                # where it was, and so does a re-coded (intra) frame, which only lowers both
+                verdict = None
+                for (x, ref, history), match in zip(bands, matches):
+                    shifted = self._texture_match(x, _warp_texture(ref, dx, dy), still)
+                    found = [v for v in (match, shifted) if v is not None]
+                    if found:
+                        history.append(max(found))
+                    # registrable if the texture matched the reference (in place or moved by the
+                    # shift found) well enough at some check: a shaking camera seldom comes back;
+                    # every band that is must agree, each by SHIFT_Z
+                    if history and max(history) >= REGISTRABLE:
+                        agrees = shifted is not None and match is not None and shifted - match > SHIFT_Z
+                        verdict = agrees if verdict is None else verdict and agrees
+                if verdict is None:
+                    flags.add("motion not verifiable")
+                elif verdict:
+                    flags.add("camera motion")
+                    self.max_shift = max(self.max_shift, shift)
+                else:
+                    moved = False
+                    self._shifts[-1] = (np.inf, np.inf)
+            elif history_due:
+                self._t_match = t
+                for (_, _, history), match in zip(bands, matches):
+                    if match is not None:
+                        history.append(match)
+        # the outline says only that the change is sharp; whether it is light or a thing is read
+        # inside it, on the wall's texture relative to its level (which light does not change)
+        chroma = self._chroma(planes, blocks, full) if self._bg_c is not None and (outlined or learn_due) else None
+        judged = hit
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
+            ratio = blocks / np.maximum(g * self._bg_b, 1e-3)
+            judged = self._objects(t, hit, broad & ok, ok, rel, ratio, chroma)
+        judged = judged | covered
+        if not moved and int(judged.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
-            self._bad |= hit
-        if suspect or moved or (broad & ok).any() or covered.any():
+            self._bad |= judged
+        # every frame for a while after anything suspect; a sharp change of light is not
+        if suspect or moved or judged.any() or ((broad & ok).any() and not outlined):
             self._dense_until = t + DENSE
         self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
+        # the wall's texture: learnt where nothing changed, slower than the background (a shadow
+        # that stays is learnt through, an object that stops is learnt like the background)
+        if not learn_due:
+            return flags
+        calm = self._pixels(~broad & ok, rel.shape)
+        b = max(1.0 - np.exp(-max(t - self._t_tex, 1e-3) / TEX_TAU), 1.0 / self._bg_n)
+        self._t_tex = t
+        tex = self._tex
+        learn = calm & np.isfinite(rel)  # an unknown pixel (an edge) keeps what was learnt
+        self._tex = np.where(learn, np.where(np.isfinite(tex), (1 - b) * tex + b * rel, rel), tex).astype(np.float32)
+        if chroma is not None:
+            keep = ~broad & ok
+            self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c).astype(np.float32)
         return flags
 
-    def _mark(self, kind: str, t: float) -> None:
-        spans = self.spans[kind]
+    @staticmethod
+    def _texture_match(rel: np.ndarray, ref: np.ndarray, where: np.ndarray) -> float | None:
+        """The regression of this frame's relative texture on the reference frame's, over
+        ``where`` (pixels; edges left out), in standard errors: large on a still wall with
+        texture (or, compressed, noise the codec froze) that registers, falling to 0 as the
+        camera moves it away."""
+        m = where & np.isfinite(rel) & np.isfinite(ref)
+        if np.count_nonzero(m) < 64:
+            return None
+        x, y = rel[m], ref[m]
+        yy = float(np.dot(y, y))
+        if yy <= 0:
+            return None
+        b = float(np.dot(x, y)) / yy
+        resid = max(float(np.dot(x, x)) - b * b * yy, 0.0) / x.size
+        # in standard errors (pixels counted a quarter, as in _objects): a wall's texture can be
+        # a small share of each pixel and still register over the whole frame
+        return b / max(float(np.sqrt(4.0 * resid / yy)), 1e-12)
+
+    @staticmethod
+    def _pixels(mask: np.ndarray, shape) -> np.ndarray:
+        """A block mask at pixel resolution (the block grid tiles ``shape``: see _whole_blocks)."""
+        import cv2
+
+        return cv2.resize(mask.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_NEAREST).astype(bool)
+
+    def _chroma(self, planes, blocks, full) -> np.ndarray | None:
+        """(2, rows, cols): the block means of the two colour planes over the luma level (U-128 and
+        V-128 for YUV, G and B for RGB), on the luma's block grid; what a change of light keeps."""
+        import cv2
+
+        if planes.u is None or planes.v is None:
+            return None
+        roi = self.roi
+        if roi is not None and planes.kind != "rgb":
+            sx, sy = planes.sub_x, planes.sub_y
+            roi = (roi[0] >> sx, roi[1] >> sy, max(1, roi[2] >> sx), max(1, roi[3] >> sy))
+        scale = np.float32(1 << (planes.depth - 8))
+        out = []
+        for a in (planes.u, planes.v):
+            c = _whole_blocks(_shrink(_crop(a, roi), full[::-1]) / scale)
+            if planes.kind != "rgb":
+                c = c - np.float32(128.0)
+            out.append(cv2.resize(c, blocks.shape[::-1], interpolation=cv2.INTER_AREA))
+        return np.stack(out) / np.maximum(blocks, DARK)
+
+    def _objects(self, t, hit, changed, ok, rel, ratio, chroma) -> np.ndarray:
+        """The blocks of ``hit`` (sharp outlines) that bound an object rather than a change of
+        light: per connected region of changed blocks, the wall's texture (relative to the level,
+        which a change of light leaves as it is) is gone from it, or the region is flat (holds
+        neither that texture nor the noise its level brings), or its colour ratios changed. The
+        other regions are sharp light on the wall: noted (see NOTES), not refused."""
+        import cv2
+
+        tex = self._tex
+        calm = ok & ~cv2.dilate(changed.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        if not calm.any():
+            calm = ok & ~changed
+        side = _block_side(rel.shape)
+        # per block: the texture's projection and energy, the frame's own relative fine energy
+        def block_sum(a):
+            return cv2.resize(a, hit.shape[::-1], interpolation=cv2.INTER_AREA) * np.float32(side * side)
+
+        # edges are no texture: a shadow's outline in this frame, or one the learnt texture kept
+        # from where a shadow stood (it is learnt where blocks are calm, not pixels), would read
+        # as texture lost; pixels far out in either are left out (the wall's texture is a few
+        # per cent with a Gaussian's tails)
+        pc = self._pixels(calm, rel.shape)
+        sx, sm = (_rms_known(a[pc]) for a in (rel, tex))
+        with np.errstate(invalid="ignore"):
+            keep = (np.abs(rel) < K_OUTLIER * sx) & (np.abs(tex) < K_OUTLIER * sm)  # NaN: no
+        r, m = np.where(keep, rel, 0.0).astype(np.float32), np.where(keep, tex, 0.0).astype(np.float32)
+        xm, mm, xx = block_sum(r * m), block_sum(m * m), block_sum(r * r)
+        known = block_sum(keep.astype(np.float32))
+
+        def beta(m):
+            """Regression of the frame's relative texture on the learnt one over blocks ``m`` and
+            its standard error (pixels counted a quarter: interpolation and the codec correlate them)."""
+            smm, sxm, sxx, n = (float(np.sum(a[m], dtype=np.float64)) for a in (mm, xm, xx, known))
+            if smm <= 0.0 or n < MIN_KNOWN * side * side:
+                return 0.0, np.inf
+            b = sxm / smm
+            resid = max(sxx - b * sxm, 0.0) / n
+            return b, float(np.sqrt(4.0 * resid / smm))
+
+        b0, se0 = beta(calm)
+        registrable = b0 > K_TEX * se0 and b0 > 0.0
+        # per block, the mean relative fine energy of its known pixels (most must be known)
+        measured = known >= side * side / 2
+        energy = np.where(measured, xx / np.maximum(known, 1.0), np.float32(1e30)) * np.maximum(ratio, 1.0)
+        e0 = float(np.median(energy[calm & measured])) if (calm & measured).any() else 0.0
+        n, labels = cv2.connectedComponents(changed.astype(np.uint8), connectivity=8)
+        out = np.zeros_like(hit)
+        sharp = []
+        for k in range(1, n):
+            region = labels == k
+            if not (hit & region).any():
+                continue
+            b, se = beta(region)
+            lost = registrable and b < KEPT * b0 and (KEPT * b0 - b) > K_TEX * se
+            flat = e0 > 0.0 and float(np.percentile(energy[region], FLAT_SHARE)) < FLAT * e0
+            lit = region & (self._bg_b >= COLOUR_LEVEL)  # darker, a ratio is its quantisation and noise
+            colour = chroma is not None and int(lit.sum()) >= COLOUR_BLOCKS and float(np.median(
+                np.hypot(*(chroma[:, lit] - self._bg_c[:, lit])))) > COLOUR
+            if self.trace is not None:
+                self.trace.append({"t": round(t, 3), "blocks": int(region.sum()), "hits": int((hit & region).sum()),
+                                   "beta": b, "se": se, "beta_calm": b0, "se_calm": se0,
+                                   "flat": float(np.min(energy[region])) / e0 if e0 > 0 else None,
+                                   "colour": None if chroma is None else float(np.median(
+                                       np.hypot(*(chroma[:, region] - self._bg_c[:, region])))),
+                                   "ratio": float(np.median(ratio[region])), "object": bool(lost or flat or colour),
+                                   "e_q": [float(x) for x in np.percentile(energy[region], [10, 25, 50])] if e0 > 0 else None,
+                                   "e0": e0, "known": float(known[region].sum()) / (side * side),
+                                   "colour_calm": None if chroma is None or not calm.any() else float(np.median(
+                                       np.hypot(*(chroma[:, calm] - self._bg_c[:, calm])))),
+                                   "level": float(np.median(self._bg_b[region]))})
+            if lost or flat or colour:
+                out |= hit & region
+            else:
+                sharp.append(region)
+        if sharp and int(out.sum()) < MIN_MOVER_BLOCKS:
+            self._mark_note("sharp light", t)
+        return out
+
+    def _mark_note(self, kind: str, t: float) -> None:
+        self._mark(kind, t, self.note_spans)
+
+    def _mark(self, kind: str, t: float, where: dict | None = None) -> None:
+        spans = (self.spans if where is None else where)[kind]
         if spans and (t - spans[-1][1] < 0.5 or len(spans) >= MAX_SPANS):
             spans[-1][1] = t
         else:
@@ -550,20 +836,25 @@ class ViewCheck:
 
     # ------------------------------------------------------------------ verdicts
     def view(self, start: float | None = None, end: float | None = None) -> dict:
-        """``{"usable", "issues", "reason"}`` over [start, end] seconds (the whole clip: no bounds)."""
+        """``{"usable", "issues", "reason", "notes"}`` over [start, end] seconds (the whole clip: no
+        bounds). Notes say what was seen that is no view fault (sharp light on the wall)."""
         lo = -np.inf if start is None else start
         hi = np.inf if end is None else end
         found = {k: [s for s in spans if s[1] >= lo and s[0] <= hi] for k, spans in self.spans.items()}
         issues = [k for k, s in found.items() if s]
+        refused = [k for k in issues if k not in NOT_REFUSED]
         if self.frames == 0:
-            return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked"}
+            return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked", "notes": []}
         reason = None
-        if issues:
-            parts = [f"{k} at {_spans_text(found[k])}" for k in issues if k != "frame gap"]
+        if refused:
+            parts = [f"{k} at {_spans_text(found[k])}" for k in refused if k != "frame gap"]
             reason = "; ".join((["not a static view of the wall: " + "; ".join(parts)] if parts else [])
                                + ([f"frames missing at {_spans_text(found['frame gap'])}"]
-                                  if found["frame gap"] else []))
-        return {"usable": not issues, "issues": issues, "reason": reason}
+                                  if "frame gap" in refused else []))
+        notes = [f"{NOTES[k]} (at {_spans_text(s)})" for k, spans in self.note_spans.items()
+                 if (s := [x for x in spans if x[1] >= lo and x[0] <= hi])]
+        notes += [f"{KINDS[k]} (at {_spans_text(found[k])})" for k in issues if k in NOT_REFUSED]
+        return {"usable": not refused, "issues": issues, "reason": reason, "notes": notes}
 
     def record(self) -> dict:
         """What :meth:`view` and :meth:`summary` answer from, as JSON (a .npz plot's metadata
