@@ -353,4 +353,4 @@ def test_a_clip_too_short_for_a_window_gets_the_files_frames_and_a_view(run_cli,
         code, out, err = run_cli(cmd, clip, "--json")
         assert code == 1 and out == ""
         line = [x for x in err.splitlines() if x.strip()][0]
-        assert "45 frame(s) at 25 fps (1.80 s)" in line and "view: usable" in line, line
+        assert "45 frame(s) decoded (1.80 s at 25 fps)" in line and "view: usable" in line, line

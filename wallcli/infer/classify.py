@@ -41,12 +41,13 @@ def _too_short_video(source: str, check, model) -> WallcliError:
     view = check.summary()
     said = "usable" if view["usable"] else view["reason"]
     need = f"{model.window / model.fps:.2f} s"
+    # worded as _too_short (and snr): "N frame(s) decoded", the file's own frames
     if fps:
         need = f"{int(np.ceil(model.window / model.fps * fps - 1e-6))} frames ({need})"
-        exc = WallcliError(f"{source} is too short: {n} frame(s) at {fps:g} fps ({n / fps:.2f} s); "
+        exc = WallcliError(f"{source} is too short: {n} frame(s) decoded ({n / fps:.2f} s at {fps:g} fps); "
                            f"one window needs {need}; view: {said}")
     else:
-        exc = WallcliError(f"{source} is too short: {n} frame(s); one window needs {need}; view: {said}")
+        exc = WallcliError(f"{source} is too short: {n} frame(s) decoded; one window needs {need}; view: {said}")
     exc.view = view
     return exc
 
