@@ -1,7 +1,7 @@
 """Record a model's transfer figures (the output of `wallcli evaluate DIR --json`) in its card.
 
     wallcli evaluate ../shared/transfer --task count --json > runs/transfer_count.json
-    python research/record_transfer.py models/count.onnx runs/transfer_count.json [CANDIDATES_COMPARED]
+    python research/record_transfer.py models/count.onnx runs/transfer_count.json [CANDIDATES_COMPARED [SINGLE_STAGE.json]]
 
 The card gains a ``transfer`` block: accuracy with its 95 % interval, coverage and accuracy of the
 decided answers, the confusion matrix and per-class figures, the clips right by SNR band
@@ -23,7 +23,7 @@ KEYS = ("clips", "scored", "errors", "accuracy", "ci95", "decided", "coverage", 
 
 
 def main() -> None:
-    if len(sys.argv) not in (3, 4):
+    if len(sys.argv) not in (3, 4, 5):
         raise SystemExit(__doc__)
     model, result_path = Path(sys.argv[1]), Path(sys.argv[2])
     result = json.loads(result_path.read_text(encoding="utf-8"))
@@ -43,6 +43,12 @@ def main() -> None:
         block["command"] += " (two-stage count: presence from both nets, then how many)"
     if len(sys.argv) > 3:  # issue 35: how many candidates were compared on this set before this one was chosen
         block["candidates_compared"] = int(sys.argv[3])
+    if len(sys.argv) > 4:  # the count net alone on the same set (`--single-stage`), beside the two-stage headline
+        alone = json.loads(Path(sys.argv[4]).read_text(encoding="utf-8"))
+        if alone.get("stages") or alone.get("model", {}).get("sha256") != card["sha256"]:
+            raise SystemExit(f"{sys.argv[4]} is not this count net alone")
+        card["transfer_single_stage"] = {k: alone[k] for k in KEYS if k in alone} | {
+            "command": "wallcli evaluate TRANSFER_DIR --task count --single-stage --json"}
     card["transfer"] = block
     with atomic_path(card_path(model), force=True) as tmp:
         write_card(tmp, card)

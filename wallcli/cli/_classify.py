@@ -128,20 +128,22 @@ def _report(task, input, model, result, st, plot, json_out, force) -> None:
     if any(not w.get("confident", True) for w in result["windows"]):
         notes.append("Each window's reason: --json (windows[].reason).")
     print_lines(notes)
-    note = accuracy_note(model.card)
+    note = accuracy_note(model.card, single_stage=task == "count" and model.single)
     if note:
         from wallcli.cli.output import log
 
         log(note)
 
 
-def accuracy_note(card: dict) -> str | None:
+def accuracy_note(card: dict, single_stage: bool = False) -> str | None:
     """One line saying how far the model's answers can be trusted, from its card's validation.
 
     Printed under the table (to stderr, for the reader, not for scripts): a probability of 0.9
     from a model that is right on 64 % of windows is not a 90 % answer.
     """
     tr = card.get("transfer") or {}
+    if single_stage and tr.get("stages"):  # the card's headline is the two-stage count's, not this net's alone
+        tr = card.get("transfer_single_stage") or {}
     if isinstance(tr.get("accuracy"), (int, float)) and isinstance(tr.get("scored"), int):
         # what users meet first: clips from a renderer the model never saw
         iv = tr.get("ci95")
@@ -149,7 +151,10 @@ def accuracy_note(card: dict) -> str | None:
         dec = ""
         if isinstance(tr.get("coverage"), (int, float)) and isinstance(tr.get("accuracy_decided"), (int, float)):
             dec = f"; it decided {tr['coverage']:.0%} of them and was right on {tr['accuracy_decided']:.0%} of those"
-        head = (f"{card.get('name', 'model')} {card.get('version', '')}: right on {tr['accuracy']:.0%}{ci} of "
+        st = tr.get("stages") if isinstance(tr.get("stages"), dict) else None
+        act = st.get("activity_model", {}) if st else {}
+        how = f" in two stages (with {act.get('name', 'activity')} {act.get('version', '')})" if st else ""
+        head = (f"{card.get('name', 'model')} {card.get('version', '')}{how}: right on {tr['accuracy']:.0%}{ci} of "
                 f"{tr['scored']} clips from an independent renderer{dec}. Rely on decided answers only.")
         sim = _simulated_note(card)
         return head + (f" On simulated validation: {sim}" if sim else " See the model card.")
