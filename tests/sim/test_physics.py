@@ -6,7 +6,8 @@ import pytest
 from wallcli.sim import bodies, flatland
 from wallcli.sim.geometry import disc_overlap, polygon_form_factor, sphere_form_factor
 from wallcli.sim.motion import standing
-from wallcli.sim.room import body_delta, overlapping_pairs, static_irradiance, uniform_room
+from wallcli.sim.bodylight import body_delta, overlapping_pairs
+from wallcli.sim.room import static_irradiance, uniform_room
 
 
 def _hemisphere_quadrature(point, covered, n=1200):
@@ -238,7 +239,7 @@ def test_area_light_sources_match_the_exact_polygon_irradiance(height):
 def test_a_person_under_a_ceiling_panel_is_lit_by_it():
     """Bodies take direct light from windows and panels, not only the room's ambient light: under
     a bright panel a raised hand is far brighter than one held low, and brighter than ambient alone."""
-    from wallcli.sim.room import body_radiance
+    from wallcli.sim.bodylight import body_radiance
 
     room = _panel_room()
     albedo = np.full((2, 3), 0.5)

@@ -3,7 +3,7 @@
 A person is 20 spheres: head, three along the torso (pelvis, belly, chest), two per upper arm,
 two per forearm, two per thigh, two per shin. The torso spheres overlap each other and the
 shoulders and hips (``OVERLAP_PAIRS``), and in profile an arm overlaps the torso; the renderer
-finds the pairs that overlap as seen from the wall (room.overlapping_pairs) and counts their
+finds the pairs that overlap as seen from the wall (bodylight.overlapping_pairs) and counts their
 common solid angle once. Limb spheres leave small gaps (a chain of spheres covers ~80 % of a
 cylinder's silhouette). The spheres' total cross-section is 0.45 m^2 for a 1.75 m adult of
 average girth (girth is randomised).

@@ -14,8 +14,8 @@ import numpy as np
 
 from wallcli.sim import WIDE_DOMAINS, bodies, motion
 from wallcli.sim.camera import Camera, CameraParams, sample_camera
-from wallcli.sim.room import (Room, body_delta, body_radiance, index_interp, overlapping_pairs, sample_room,
-                              static_irradiance)
+from wallcli.sim.bodylight import body_delta, body_radiance, overlapping_pairs
+from wallcli.sim.room import Room, index_interp, sample_room, static_irradiance
 from wallcli.sim.shadows import shadow_delta
 
 ACTIVITIES = motion.ACTIVITIES

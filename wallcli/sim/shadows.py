@@ -1,6 +1,6 @@
 """People's shadows on the room's other surfaces, as the observed wall sees them.
 
-room.body_delta gives what a body does to the observed wall directly: it hides the room behind it
+bodylight.body_delta gives what a body does to the observed wall directly: it hides the room behind it
 and shows its own lit surface. A body also intercepts light on its way from every lamp, window and
 ceiling panel to the floor, the ceiling and the other walls; those surfaces then reflect less onto
 the observed wall. In a path tracer (and in a real room) this is a whole-wall dimming that follows
@@ -10,7 +10,7 @@ without it).
 
 Model, per light source s and body sphere j (both exact in the limit of small spheres):
 - the sphere intercepts the flux I_s(u) * pi r^2 / R^2 (times the part of its disc that no nearer
-  sphere already covers, seen from the source: room.hidden_fraction);
+  sphere already covers, seen from the source: bodylight.hidden_fraction);
 - that flux is missing where the ray from the source through the sphere's centre meets a room
   surface (its shadow: the flux a shadow removes from a plane equals the flux the occluder
   intercepts, whatever the plane's slope);
@@ -20,7 +20,7 @@ Model, per light source s and body sphere j (both exact in the limit of small sp
 - the rest of the room's interreflected light (the closed-box ambient of room.py) loses the part of
   the flux the body absorbs, (1 - albedo) * Phi: a uniform change of rho_mean^2 / (1 - rho_mean) /
   area per unit flux over the whole observed wall.
-Shadows that fall on the observed wall itself (y = 0) are room.body_delta's (lamps) or belong to
+Shadows that fall on the observed wall itself (y = 0) are bodylight.body_delta's (lamps) or belong to
 no patch the wall sees (a plane does not light itself), so they are skipped.
 """
 
@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.sim.room import NORMALS, TEX, Room, hidden_fraction, index_interp, overlapping_pairs
+from wallcli.sim.bodylight import hidden_fraction, overlapping_pairs
+from wallcli.sim.room import NORMALS, TEX, Room, index_interp
 
 SUB = 6  # the term is smooth over the wall (distant, soft sources): exact on SUB x SUB points
 
