@@ -135,7 +135,8 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.snr import GridAccumulator, SnrAccumulator, snr_db, snr_report
+    from wallcli.signal.snr import SnrAccumulator, snr_db, snr_report
+    from wallcli.signal.snr_map import GridAccumulator
     from wallcli.signal.view import ViewCheck
     from wallcli.wording import format_db
 
@@ -276,7 +277,7 @@ def _parse_sweep(text: str) -> tuple[str, list[float]]:
 def _one(p: dict, approx: bool) -> dict:
     import math
 
-    from wallcli.signal.snr import predict
+    from wallcli.signal.snr_predict import predict
 
     radius = math.sqrt(p["area"] / math.pi) if p["area"] is not None else p["radius"]
     contrast = p["contrast"] if p["contrast"] is not None else p["person_radiance"] - p["background_radiance"]

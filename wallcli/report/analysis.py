@@ -35,7 +35,7 @@ class ClipAnalysis:
     roi: tuple[int, int, int, int]  # of the space-time plots, in source pixels
     plot: Any  # wallcli.signal.stplot.StPlot
     snr: Any  # wallcli.signal.snr.SnrResult
-    grid: Any  # wallcli.signal.snr.GridAccumulator
+    grid: Any  # wallcli.signal.snr_map.GridAccumulator
     frame: np.ndarray  # the first decoded frame, RGB float32 0-255
     models: dict[str, Any]  # task -> wallcli.infer.model.Model
     results: dict[str, dict] = field(default_factory=dict)  # task -> docs/contract.md result
@@ -67,7 +67,8 @@ class _Tee:
 
     def frames(self):
         from wallcli.signal.blocks import check_roi
-        from wallcli.signal.snr import DEFAULT_MAX_PIXELS, GridAccumulator, SnrAccumulator
+        from wallcli.signal.snr import DEFAULT_MAX_PIXELS, SnrAccumulator
+        from wallcli.signal.snr_map import GridAccumulator
 
         self.last = 0.0
         for frame in self._reader.frames():
