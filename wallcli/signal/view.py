@@ -15,298 +15,25 @@ the sub-pixel shake a tripod on a floor has, which corrections (not refusal) dea
 """
 from __future__ import annotations
 
-import statistics
 from collections import deque
 
 import numpy as np
 
+from wallcli.signal.view_cut import CutWatch
+from wallcli.signal.view_image import (
+    _block_side, _broad_blur, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
+)
+from wallcli.signal.view_light import _chroma, _objects, _relative_texture
+from wallcli.signal.view_limits import (
+    CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
+    MATCH_RATE, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES, REL, REL_EDGE,
+    SHARP, SIGMA_FLOOR, TEX_TAU,
+)
+from wallcli.signal.view_motion import _in_band, _motion_verdict, _shift_fits, _texture_match
 from wallcli.wording import span_text
 
-MAX_SIDE = 320  # registration scale: finer texture than this is not needed to see a pan
-BLOCKS = 40  # blocks along the long side for movers and cuts: a person in view covers several
-K_MOVER = 8.0  # a block changed by this many noise sigmas (and REL) from its slow background
-REL_EDGE = 0.05  # whose fine structure changed by an RMS over this fraction of the level (REL: no
-# hidden person changes the wall by that much, outline or not)
-K_EDGE = 4.0  # and this many spreads above the frame's median block residual (its noise, texture
-# and codec residue in the fine band): the RMS of n pixels spreads by about median/sqrt(2 n), n
-# counted as a quarter of the block's pixels (see K_SHIFT); a block of a 96-pixel-wide frame is 2x2
-# pixels, of a 320-pixel one 8x8 (three refused some transfer-set walls as movers; six
-# missed a 40-60 % sprite on a dark noisy wall that four catches)
-SHARP = 0.15  # and over this fraction of the step it bounds (the largest change among the block and
-# its 8 neighbours): an in-focus outline (blurred by a pixel or less) puts 0.09-0.11 of its step into
-# the fine band on its own and the wall texture it hides adds to that (simulated objects: 0.2 and
-# more), a penumbra of 4 px or more puts under 0.05; deep simulated shadows (half the level) reached
-# 0.13 with the codec's re-coding residue on top. Session 17 (research/view/README.md):
-# with a floor of 10 % of the level alone, faint objects (15-40 % contrast) were caught a quarter of
-# the time, while hard shadows of people 1-2 m from the wall (half the level, the codec re-coding
-# them) were refused as movers; these three together catch more of the one and none of the other
-FINE = 2.0  # pixels (at the registration scale): the outline's scale
-EDGE_LEVEL = 40.0  # code values: under it, the level floor (noise, not contrast, rules dark walls)
-K_CUT = 8.0
-REL = 0.05  # of the local level: above any hidden person's shadow
-REL_CUT = 0.02  # one frame to the next: a shadow moves, it does not change a fifth of the wall at once
-CUT_FRACTION = 0.2  # of the usable blocks (simulated walls: at most 1.5 %; cuts between two: 40 % and more)
-CUT_SIDE = 160  # samples along the long side for the cut watch (4x4 per block at 16:9)
-CUT_RATE = 15.0  # frames a second the cut watch compares (every other frame at 30 fps): a cut is
-# one jump between any two of them, while a sweeping shadow changes a sample pair 2 frames apart
-# by a third of what 6 frames (a full check's spacing) did on the walls measured
-CUT_CALM = 0.1  # the frames before and after a cut (a codec settling after one, a shadow: up to 9 %)
-# A cut between two views of alike walls can change under a fifth of the blocks by 2 %: most of the
-# change is then the frame's gain, which is divided out, and a little of its spatial pattern. What is
-# left is coarse (the other room's shading) and comes in one step, while the codec's re-coding is
-# fine-grained and a person's light changes over many frames. So the gain-free step is also read on
-# CUT_CELLS cells along the long side, as an RMS relative to the level: a cut is a step CUT_SPIKE
-# times the clip's median step and each of the CUT_REACH steps on either side, and over REL_CUT / 2
-# (no hidden person changes that much of the wall's pattern between two samples). Session 18
-# (research/view/README.md): steps over the floor reached at most 2.7 times on 220 walls; the 15
-# cuts the changed share missed, 2.0-48 times (13 over 4)
-CUT_CELLS = 8
-CUT_SPIKE = 4.0
-CUT_REACH = 2
-MIN_MOVER_BLOCKS = 2
-MIN_SHIFT = 1.5  # source pixels from the reference frame
-K_SHIFT = 3.0  # z-score of the shift's fit against its mirror image (see _changes), held over
-HOLD, HOLD_WITHIN = 3, 8  # agreeing frames among the last few: the phase correlation picks the best
-# of many shifts, so noise alone scores a few, but its peaks land anywhere; on a noisy wall the
-# true peak wins only in some frames, so agreement is asked of 3 of 8, not of 3 in a row
-DARK = 10.0  # 8-bit code values: 1 % of the level is then a tenth of a quantisation step
-CLIP_HI = 250.0
-MIN_USABLE = 0.5  # of the frame's area, neither clipped nor dark
-SIGMA_FLOOR = 0.02  # code values: a frozen (repeated) frame has no measurable noise
-HISTORY = 64  # frames whose noise estimates are pooled (a median: a cut or a mover does not move it)
-MAX_SPANS = 64  # per kind; more are merged, so memory stays bounded
-CHECK_RATE = 3.0  # frames checked per second of a calm view: checking every frame cost more than
-# the analysis itself (3-5 ms a 1080p frame against about 3 for decoding and the plots;
-# bench/RESULTS.md). After a check that finds anything suspect (a shift that fits, a block far off
-# its background; or a frame of the cut watch with a large changed share) every frame is checked
-# for DENSE seconds, so the rules that ask for agreement between neighbouring frames (a shake's
-# shifts) and a mover's outline get every frame's chance, as before
-DENSE = 0.5
-MATCH_RATE = 1.0  # checks a second that learn the texture and colour and measure how registrable the
-# wall is (see REGISTRABLE): each is a few tenths of a ms, and light and texture change slowly
-
-TEX_TAU = 4.0  # seconds: the wall's texture is learnt where nothing changed, over this time
-EDGE_GRAD = 0.02  # of the level a pixel, at the outline's scale FINE: a step of 10 % (a wall's texture
-# of a few per cent a pixel, blurred by FINE, stayed under 0.9 % on the bundled examples)
-K_OUTLIER = 3.0  # RMS of the calm blocks: beyond it a pixel of either texture is an edge, not texture
-# A region is an object when (any of):
-# - the wall's texture is gone: its regression on the learnt texture is under KEPT of the calm
-#   blocks' by K_TEX standard errors (with MIN_KNOWN blocks' worth of pixels that are no edge).
-#   Not a half: a compressed wall's calm blocks are copied from frame to frame, frozen noise and
-#   all, while the codec re-codes a moving shadow and keeps a tenth to a half of the texture there
-#   (sharp-shadow walls at CRF 18: 0.1-0.4; the same walls lossless: all of it);
-# - it is flat: FLAT_SHARE % of its blocks hold under FLAT of the calm blocks' relative fine
-#   energy (at their level): neither the wall's texture nor the noise that light brings;
-# - its colour ratios moved by over COLOUR (on COLOUR_BLOCKS blocks or more, of a background level
-#   of COLOUR_LEVEL or more: a small deep shadow under two lights of other colours moved them by up
-#   to 0.25, a shadow taking half the light of a room lit in two colours by 0.10, and on a wall of
-#   level 30 a ratio's quantisation alone is 0.03). On the simulator's objects it adds next to
-#   nothing to the two rules above; it is there for real objects on walls with no texture.
-# Chosen on session 19's first 16 rounds (research/view/README.md); COLOUR_LEVEL and COLOUR 0.15
-# after false alarms of the whole sample were seen (walls of level 30; the half-light shadow).
-MIN_KNOWN = 4
-KEPT = 0.1
-K_TEX = 4.0
-FLAT, FLAT_SHARE = 0.02, 10
-COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL = 0.15, 4, 60.0
-NOTES = {"sharp light": "sharp shadow or light in view: a person near the wall or a small light"}
-
-REGISTRABLE = 8.0  # standard errors: the best texture match with the reference frame (see
-# _texture_match; in place, or moved by the shift found) over the last checks, of a wall whose
-# camera motion can be verified: under it the texture is under the
-# noise, and a shift the correlation finds is no proof
-SHIFT_Z = 3.0  # standard errors by which the reference moved by the shift must fit better than in place
-# (session 19: four still walls had the finest band's two within 0.3-1.5 and the other band's reversed)
-NOT_REFUSED = ("motion not verifiable",)  # issues that say what could not be checked; answers stand
-
-KINDS = {
-    "camera motion": "the camera moved",
-    "motion not verifiable": "the wall has no texture to register on: whether the camera moved is not known",
-    "moving object": "something moved in view",
-    "scene cut": "the shot changes",
-    "clipped": "much of the frame is clipped",
-    "too dark": "much of the frame is too dark",
-    "too little usable area": "too little of the frame is usable",
-    "too thin to check": "the frame is too thin to check for camera motion",
-    # not the view's fault but the file's: frames lost (their timestamps jump, io.video.GAP_FACTOR);
-    # nothing spanning it is continuous video
-    "frame gap": "frames are missing",
-}
-
-
-def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """A plane (native integer codes) as float32 at ``size`` (w, h). A large plane is halved by
-    2x2 area averages in its own integer type while it stays at least twice the size (OpenCV's
-    2x2 path takes 0.07 ms for 1080p; rounding there adds 0.3 codes of noise to averages whose
-    noise the thresholds measure anyway), then brought to ``size`` bilinearly: the last factor is
-    under 2, and OpenCV's area resize for such factors took three times the rest together."""
-    import cv2
-
-    while a.dtype in (np.uint8, np.uint16) and a.shape[1] >= 2 * size[0] and a.shape[0] >= 2 * size[1]:
-        h, w = a.shape
-        a = cv2.resize(a[:h - h % 2, :w - w % 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA)
-    a = a.astype(np.float32)
-    if a.shape[::-1] == tuple(size):
-        return a
-    fast = a.shape[1] < 2 * size[0] and a.shape[0] < 2 * size[1]
-    return cv2.resize(a, size, interpolation=cv2.INTER_LINEAR if fast else cv2.INTER_AREA)
-
-
-def _crop(a: np.ndarray, roi) -> np.ndarray:
-    if roi is None:
-        return a
-    x, y, w, h = roi
-    c = a[y:y + h, x:x + w]
-    return c if min(c.shape) >= 8 else a  # a bad ROI is the reader's error to give
-
-
-def _sampled_luma(planes, roi, max_side: int) -> np.ndarray:
-    """Luma of the frame (or its ROI) on the 0-255 scale, float32, one pixel in every ``step`` on
-    each axis so that the long side has at most ``max_side`` samples (OpenCV's nearest-neighbour
-    gather: a tenth of the cost of a strided copy, and no area resize of the whole plane)."""
-    import cv2
-
-    y = _crop(planes.y, roi)
-    h, w = y.shape
-    step = max(1, -(-max(h, w) // max_side))
-    size = (max(1, w // step), max(1, h // step))
-
-    def sample(a):
-        a = a if step == 1 else cv2.resize(a[: size[1] * step, : size[0] * step], size, interpolation=cv2.INTER_NEAREST)
-        return a.astype(np.float32)
-
-    scale = np.float32(1 << (planes.depth - 8))
-    y = sample(y)
-    if planes.kind == "rgb":
-        g, b = sample(_crop(planes.u, roi)), sample(_crop(planes.v, roi))
-        return (np.float32(0.299) * y + np.float32(0.587) * g + np.float32(0.114) * b) / scale
-    y /= scale
-    if not planes.full_range:
-        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
-    return y
-
-
-def _grey(planes, roi, max_side: int) -> tuple[np.ndarray, int]:
-    """Luma of the frame (or its ROI) as float32 on the 0-255 scale, at most ``max_side`` pixels
-    on its long side (what the wall's level is judged on), and the source width it stands for."""
-    def crop(a):
-        return _crop(a, roi)
-
-    Y = crop(planes.y)
-    h, w = Y.shape
-    s = min(1.0, max_side / max(h, w))
-    size = (max(1, round(w * s)), max(1, round(h * s)))
-    scale = float(1 << (planes.depth - 8))
-    if planes.kind == "rgb":
-        y = (0.299 * _shrink(Y, size) + 0.587 * _shrink(crop(planes.u), size) + 0.114 * _shrink(crop(planes.v), size)) / scale
-        return y.astype(np.float32), w
-    y = _shrink(Y, size) / np.float32(scale)
-    if not planes.full_range:
-        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
-    return y, w
-
-
-def _robust_sigma(d: np.ndarray) -> float:
-    """Sigma of one image from a difference of two: the RMS of the smallest 90 % of |d| (of the
-    differences the codec coded, see _coded), scaled to a Gaussian's. Not the median: H.264
-    repeats static blocks exactly, so most differences of a compressed wall are 0 and the median
-    says 'no noise'; the trimmed tail keeps a mover out."""
-    d = np.ravel(d)
-    if d.size == 0:
-        return 0.0
-    if d.size > 4096:  # a fixed stride of the image: as good an estimate for a tenth of the sorting
-        d = d[:: d.size // 2048]
-    d = _coded(d)
-    a = np.abs(d - _upper_median(d))
-    k = int(0.9 * (a.size - 1))
-    keep = np.partition(a, k)[:k + 1]  # partitions, not numpy's median and quantile: a tenth of the time
-    return float(np.sqrt(np.mean(keep * keep, dtype=np.float64) / 0.623 / 2.0))
-
-
-def _block_side(shape) -> int:
-    """Pixels per (square) block: BLOCKS blocks along the long side, at least 4 along the short."""
-    return max(1, min(max(shape) // BLOCKS, min(shape) // 4))
-
-
-def _whole_blocks(img: np.ndarray) -> np.ndarray:
-    """The centre of ``img`` that whole blocks tile (a few rows or columns at most are left out):
-    block means then take OpenCV's integer-factor area path, ten times faster than its general one."""
-    side = _block_side(img.shape)
-    h, w = img.shape
-    dh, dw = h % side, w % side
-    return img[dh // 2: h - (dh - dh // 2), dw // 2: w - (dw - dw // 2)]
-
-
-def _coded(d: np.ndarray) -> np.ndarray:
-    """The differences a codec actually coded: where most of a compressed wall is repeated exactly
-    from the frame before (H.264 skip blocks: at CRF 28 nearly all of it), the noise is what the
-    updated blocks show, not the zeros, which made every threshold built on it nothing and had
-    still walls refused as moving (2-3 of 12 walls at CRF 28)."""
-    nz = d[d != 0]
-    return nz if d.size // 2 > nz.size >= 16 else d
-
-
-def _upper_median(x: np.ndarray) -> float:
-    k = x.size // 2
-    return float(np.partition(x, k)[k])
-
-
-def _highpass(img: np.ndarray, sigma: float = 4.0) -> np.ndarray:
-    import cv2
-
-    return img - cv2.GaussianBlur(img, (0, 0), sigma)
-
-
-def _relative_texture(small: np.ndarray, fine: np.ndarray) -> np.ndarray:
-    """The fine band relative to the local level: what a change of light leaves as it is (texture,
-    fixed pattern). Where the level itself changes fast (an edge of light, over EDGE_GRAD of the
-    level a pixel) it is NaN, unknown: the edge is no texture."""
-    import cv2
-
-    low = small - fine
-    level = np.maximum(low, 1.0)
-    gx = cv2.Sobel(low, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(low, cv2.CV_32F, 0, 1, ksize=3)
-    edge = cv2.dilate(((gx * gx + gy * gy) > (8.0 * EDGE_GRAD * level) ** 2).astype(np.uint8), np.ones((3, 3), np.uint8))
-    return np.where(edge.astype(bool), np.float32(np.nan), fine / level)
-
-
-def _in_band(hp: np.ndarray, small: np.ndarray, fine: np.ndarray, rel: np.ndarray) -> np.ndarray:
-    """The registration band ``hp`` relative to the local level, unknown where ``rel`` (the
-    relative texture) is: what camera motion is verified on, the band the shift was found in
-    (a wall's finest texture is what a codec keeps least)."""
-    return np.where(np.isfinite(rel), hp / np.maximum(small - fine, 1.0), np.float32(np.nan)).astype(np.float32)
-
-
-def _rms_known(a: np.ndarray) -> float:
-    """RMS of the finite values of ``a``; infinite (no bound) when there are none."""
-    a = a[np.isfinite(a)]
-    return float(np.sqrt(np.mean(a * a))) if a.size else np.inf
-
-
-def _warp_texture(tex: np.ndarray, dx: float, dy: float) -> np.ndarray:
-    """``tex`` moved by (dx, dy) pixels; NaN (unknown) where any unknown or outside pixel enters."""
-    import cv2
-
-    known = np.isfinite(tex)
-    m = np.float32([[1, 0, dx], [0, 1, dy]])
-    size = tex.shape[::-1]
-    moved = cv2.warpAffine(np.where(known, tex, 0.0).astype(np.float32), m, size, flags=cv2.INTER_LINEAR)
-    ok = cv2.warpAffine(known.astype(np.float32), m, size, flags=cv2.INTER_LINEAR, borderValue=0.0) > 0.999
-    return np.where(ok, moved, np.float32(np.nan))
-
-
-def _broad_blur(img: np.ndarray, sigma: float) -> np.ndarray:
-    """A Gaussian blur of large ``sigma`` computed at a quarter of the size (what it keeps has no
-    detail finer than that) and brought back bilinearly: a tenth of the cost of the full kernel."""
-    import cv2
-
-    h, w = img.shape
-    if sigma < 6.0 or min(h, w) < 32:
-        return cv2.GaussianBlur(img, (0, 0), sigma)
-    small = cv2.resize(img, (max(1, w // 4), max(1, h // 4)), interpolation=cv2.INTER_AREA)
-    small = cv2.GaussianBlur(small, (0, 0), np.sqrt(max(sigma ** 2 - 4.0, 1.0)) / 4.0)
-    return cv2.resize(small, (w, h), interpolation=cv2.INTER_LINEAR)
+# what other modules import from here (the thresholds live in view_limits)
+__all__ = ["KINDS", "MAX_SPANS", "NOTES", "NOT_REFUSED", "ViewCheck"]
 
 
 class ViewCheck:
@@ -334,11 +61,7 @@ class ViewCheck:
         self._gap = np.inf  # the shortest time between two checked frames: one frame interval
         self._scale = 1.0
         self._window = None
-        self._fracs = (1.0, 1.0)  # changed shares of the last two frames (none calm before the first)
-        self._cut_prev = self._cut_t = None
-        self._cut_sig: deque = deque(maxlen=HISTORY)
-        # the coarse gain-free steps (time of the later sample, RMS): the clip's, and the last few
-        self._cut_steps: deque = deque(maxlen=HISTORY + CUT_REACH + 1)
+        self._cut = CutWatch()
         self._cut_reset = False
         self._shifts: deque = deque(maxlen=HOLD_WITHIN)  # recent significant shifts (inf: none)
         # where the view failed, per block (clipped, too dark, or a mover in it), OR-ed over the
@@ -379,7 +102,11 @@ class ViewCheck:
         self.seen += 1
         # these images are too small for OpenCV's pool's hand-offs to pay (blocks.one_opencv_thread)
         with one_opencv_thread():
-            cut = self._watch_cut(t, planes) if self._cut_t is None or t - self._cut_t >= 1.0 / CUT_RATE - 1e-3 else None
+            cut = None
+            if self._cut.due(t):
+                cut, busy = self._cut(t, planes, self.roi)
+                if busy:
+                    self._dense_until = t + DENSE
             if cut is not None:
                 self._mark("scene cut", cut)
                 self._cut_reset = True
@@ -387,72 +114,6 @@ class ViewCheck:
                 return
             self._t_checked = t
             self._update(t, planes)
-
-    def _watch_cut(self, t: float, planes) -> float | None:
-        """The time of the previous sample if it was a cut: much of the frame changed from the
-        sample before it, beyond a whole-frame gain (exposure, flicker), with calm samples on
-        either side (a hard shadow sweeping the wall changes as much, but over several frames).
-        Judged on CUT_RATE frames a second, one sample late, on block means of the luma sampled
-        at most CUT_SIDE pixels wide (a cut changes whole blocks: a gather of pixels, not a resize,
-        is enough to see it)."""
-        import cv2
-
-        y = _whole_blocks(_sampled_luma(planes, self.roi, CUT_SIDE))
-        bh, bw = (n // _block_side(y.shape) for n in y.shape)
-        blocks = cv2.resize(y, (bw, bh), interpolation=cv2.INTER_AREA)
-        prev, t_prev = self._cut_prev, self._cut_t
-        self._cut_prev, self._cut_t = blocks, t
-        if prev is None or prev.shape != blocks.shape:
-            return None
-        # every step on a few hundred blocks: each numpy call's overhead, not its work, is the cost
-        ok = (np.minimum(blocks, prev) >= DARK) & (np.maximum(blocks, prev) < CLIP_HI)
-        b, p = blocks[ok], prev[ok]
-        if b.size == 0:
-            return None
-        self._cut_sig.append(_robust_sigma(b - p))
-        sigma = max(statistics.median(self._cut_sig), SIGMA_FLOOR)
-        gain = _upper_median(b / p)  # p >= DARK > 0
-        threshold = np.maximum(b * REL_CUT, K_CUT * sigma * np.sqrt(2.0))
-        frac = np.count_nonzero(np.abs(b - gain * p) > threshold) / b.size
-        before = self._fracs
-        self._fracs = (before[1], frac)
-        if frac >= CUT_CALM:
-            self._dense_until = t + DENSE
-        spike = self._coarse_spike(t, blocks, prev, ok, gain)
-        if before[1] > CUT_FRACTION and before[0] < CUT_CALM and frac < CUT_CALM:
-            return t_prev
-        return spike
-
-    def _coarse_spike(self, t, blocks, prev, ok, gain) -> float | None:
-        """The time of the step CUT_REACH samples back if it was a cut by its coarse pattern (see
-        CUT_CELLS): a step far above the clip's usual and its neighbours', and above REL_CUT / 2."""
-        import cv2
-
-        k = max(1, max(blocks.shape) // CUT_CELLS)
-        hh, ww = blocks.shape[0] // k * k, blocks.shape[1] // k * k
-        step = np.nan
-        if hh and ww and ok.mean() >= MIN_USABLE:
-            r = np.where(ok, (blocks - gain * prev) / np.maximum(prev, DARK), 0.0).astype(np.float32)
-            size = (ww // k, hh // k)
-            cells = cv2.resize(r[:hh, :ww], size, interpolation=cv2.INTER_AREA)
-            share = cv2.resize(ok[:hh, :ww].astype(np.float32), size, interpolation=cv2.INTER_AREA)
-            m = share > 0.5  # cells mostly usable: their mean is the usable blocks' mean
-            if m.any():
-                step = float(np.sqrt(np.mean((cells[m] / share[m]) ** 2)))
-        steps = self._cut_steps
-        steps.append((t, step))
-        n = 2 * CUT_REACH + 1
-        if len(steps) < n + 3:  # a median of at least 3 earlier steps
-            return None
-        recent = [s for _, s in list(steps)[-n:]]
-        t_mid, mid = steps[-CUT_REACH - 1]
-        if not mid > REL_CUT / 2:  # nan (too little usable) too
-            return None
-        others = [s for i, s in enumerate(recent) if i != CUT_REACH and s == s]
-        earlier = [s for _, s in list(steps)[:-n + CUT_REACH] if s == s]
-        if len(earlier) < 3 or (others and mid <= CUT_SPIKE * max(others)):
-            return None
-        return t_mid if mid > CUT_SPIKE * statistics.median(earlier) else None
 
     def _update(self, t: float, planes) -> None:
         import cv2
@@ -529,7 +190,7 @@ class ViewCheck:
         self._tex = _relative_texture(small, self._bg_h)
         self._ref_rel = _in_band(hp, small, self._bg_h, self._tex)
         self._ref_fine = self._tex
-        self._bg_c = self._chroma(planes, blocks, full)
+        self._bg_c = _chroma(planes, self.roi, blocks, full)
         self._bg_n = 1
         self._t_tex, self._t_match = self._t_checked, -np.inf  # how registrable: from the next check
         self._match.clear()  # a new view (a cut): how registrable it is is its own
@@ -572,20 +233,7 @@ class ViewCheck:
         # a shift of half the floor that fits is not motion yet, but a shake on its way to it:
         # every frame is then checked (see CHECK_RATE), as the old every-frame check did
         if shift >= MIN_SHIFT / 2 and min(hp.shape) > 32:  # smaller: no structure to register on
-            # the reference moved by +s must fit far better than moved by -s: both warps smooth
-            # its noise alike, so only a real shift of shared structure separates them; the
-            # spread of the difference of two means of N squared residuals is e*sqrt(8/N), N
-            # counted as a quarter of the pixels (interpolation and compression correlate them).
-            # e is the residual itself, not the frame-to-frame noise: a codec that repeats static
-            # blocks makes consecutive frames alike but not the reference's texture
-            c = slice(8, -8)
-            e = []
-            for sg in (1, -1):
-                m = np.float32([[1, 0, sg * dx], [0, 1, sg * dy]])
-                warped = cv2.warpAffine(self._ref_h, m, hp.shape[::-1], borderMode=cv2.BORDER_REFLECT)
-                e.append(float(np.mean((hp - warped)[c, c] ** 2)))
-            n = hp[c, c].size / 4
-            fits = (e[1] - e[0]) > K_SHIFT * max(e[0], var_h) * np.sqrt(8.0 / n)
+            fits = _shift_fits(self._ref_h, hp, dx, dy, var_h)
             # and it must hold from one frame to the next: a camera moves smoothly, while the
             # correlation peaks of noise land anywhere
             suspect |= fits
@@ -635,27 +283,13 @@ class ViewCheck:
         outlined = not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS
         rel = _relative_texture(small, fine) if moved or outlined or learn_due or history_due else None
         if moved or history_due:
-            still = self._pixels(ok & ~broad, rel.shape)
+            still = _pixels(ok & ~broad, rel.shape)
             # two bands: the finest texture tells small shifts apart best but is what a codec keeps
             # least; the registration band (where the shift was found) is kept, but smooth
             bands = ((rel, self._ref_fine, self._match_fine), (_in_band(hp, small, fine, rel), self._ref_rel, self._match))
-            matches = [self._texture_match(x, ref, still) for x, ref, _ in bands]
+            matches = [_texture_match(x, ref, still) for x, ref, _ in bands]
             if moved:
-                # the camera moved by the shift if the reference's texture fits better moved by it
-                # than where it was: a moving edge of light that the correlation locked on leaves it
-                # where it was, and so does a re-coded (intra) frame, which only lowers both
-                verdict = None
-                for (x, ref, history), match in zip(bands, matches):
-                    shifted = self._texture_match(x, _warp_texture(ref, dx, dy), still)
-                    found = [v for v in (match, shifted) if v is not None]
-                    if found:
-                        history.append(max(found))
-                    # registrable if the texture matched the reference (in place or moved by the
-                    # shift found) well enough at some check: a shaking camera seldom comes back;
-                    # every band that is must agree, each by SHIFT_Z
-                    if history and max(history) >= REGISTRABLE:
-                        agrees = shifted is not None and match is not None and shifted - match > SHIFT_Z
-                        verdict = agrees if verdict is None else verdict and agrees
+                verdict = _motion_verdict(bands, matches, still, dx, dy)
                 if verdict is None:
                     flags.add("motion not verifiable")
                 elif verdict:
@@ -671,11 +305,14 @@ class ViewCheck:
                         history.append(match)
         # the outline says only that the change is sharp; whether it is light or a thing is read
         # inside it, on the wall's texture relative to its level (which light does not change)
-        chroma = self._chroma(planes, blocks, full) if self._bg_c is not None and (outlined or learn_due) else None
+        chroma = _chroma(planes, self.roi, blocks, full) if self._bg_c is not None and (outlined or learn_due) else None
         judged = hit
         if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
             ratio = blocks / np.maximum(g * self._bg_b, 1e-3)
-            judged = self._objects(t, hit, broad & ok, ok, rel, ratio, chroma)
+            judged, light = _objects(t, hit, broad & ok, ok, rel, ratio, chroma, self._tex, self._bg_b, self._bg_c,
+                                     self.trace)
+            if light:
+                self._mark_note("sharp light", t)
         judged = judged | covered
         if not moved and int(judged.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
@@ -689,7 +326,7 @@ class ViewCheck:
         # that stays is learnt through, an object that stops is learnt like the background)
         if not learn_due:
             return flags
-        calm = self._pixels(~broad & ok, rel.shape)
+        calm = _pixels(~broad & ok, rel.shape)
         b = max(1.0 - np.exp(-max(t - self._t_tex, 1e-3) / TEX_TAU), 1.0 / self._bg_n)
         self._t_tex = t
         tex = self._tex
@@ -700,129 +337,6 @@ class ViewCheck:
             self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c).astype(np.float32)
         return flags
 
-    @staticmethod
-    def _texture_match(rel: np.ndarray, ref: np.ndarray, where: np.ndarray) -> float | None:
-        """The regression of this frame's relative texture on the reference frame's, over
-        ``where`` (pixels; edges left out), in standard errors: large on a still wall with
-        texture (or, compressed, noise the codec froze) that registers, falling to 0 as the
-        camera moves it away."""
-        m = where & np.isfinite(rel) & np.isfinite(ref)
-        if np.count_nonzero(m) < 64:
-            return None
-        x, y = rel[m], ref[m]
-        yy = float(np.dot(y, y))
-        if yy <= 0:
-            return None
-        b = float(np.dot(x, y)) / yy
-        resid = max(float(np.dot(x, x)) - b * b * yy, 0.0) / x.size
-        # in standard errors (pixels counted a quarter, as in _objects): a wall's texture can be
-        # a small share of each pixel and still register over the whole frame
-        return b / max(float(np.sqrt(4.0 * resid / yy)), 1e-12)
-
-    @staticmethod
-    def _pixels(mask: np.ndarray, shape) -> np.ndarray:
-        """A block mask at pixel resolution (the block grid tiles ``shape``: see _whole_blocks)."""
-        import cv2
-
-        return cv2.resize(mask.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_NEAREST).astype(bool)
-
-    def _chroma(self, planes, blocks, full) -> np.ndarray | None:
-        """(2, rows, cols): the block means of the two colour planes over the luma level (U-128 and
-        V-128 for YUV, G and B for RGB), on the luma's block grid; what a change of light keeps."""
-        import cv2
-
-        if planes.u is None or planes.v is None:
-            return None
-        roi = self.roi
-        if roi is not None and planes.kind != "rgb":
-            sx, sy = planes.sub_x, planes.sub_y
-            roi = (roi[0] >> sx, roi[1] >> sy, max(1, roi[2] >> sx), max(1, roi[3] >> sy))
-        scale = np.float32(1 << (planes.depth - 8))
-        out = []
-        for a in (planes.u, planes.v):
-            c = _whole_blocks(_shrink(_crop(a, roi), full[::-1]) / scale)
-            if planes.kind != "rgb":
-                c = c - np.float32(128.0)
-            out.append(cv2.resize(c, blocks.shape[::-1], interpolation=cv2.INTER_AREA))
-        return np.stack(out) / np.maximum(blocks, DARK)
-
-    def _objects(self, t, hit, changed, ok, rel, ratio, chroma) -> np.ndarray:
-        """The blocks of ``hit`` (sharp outlines) that bound an object rather than a change of
-        light: per connected region of changed blocks, the wall's texture (relative to the level,
-        which a change of light leaves as it is) is gone from it, or the region is flat (holds
-        neither that texture nor the noise its level brings), or its colour ratios changed. The
-        other regions are sharp light on the wall: noted (see NOTES), not refused."""
-        import cv2
-
-        tex = self._tex
-        calm = ok & ~cv2.dilate(changed.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-        if not calm.any():
-            calm = ok & ~changed
-        side = _block_side(rel.shape)
-        # per block: the texture's projection and energy, the frame's own relative fine energy
-        def block_sum(a):
-            return cv2.resize(a, hit.shape[::-1], interpolation=cv2.INTER_AREA) * np.float32(side * side)
-
-        # edges are no texture: a shadow's outline in this frame, or one the learnt texture kept
-        # from where a shadow stood (it is learnt where blocks are calm, not pixels), would read
-        # as texture lost; pixels far out in either are left out (the wall's texture is a few
-        # per cent with a Gaussian's tails)
-        pc = self._pixels(calm, rel.shape)
-        sx, sm = (_rms_known(a[pc]) for a in (rel, tex))
-        with np.errstate(invalid="ignore"):
-            keep = (np.abs(rel) < K_OUTLIER * sx) & (np.abs(tex) < K_OUTLIER * sm)  # NaN: no
-        r, m = np.where(keep, rel, 0.0).astype(np.float32), np.where(keep, tex, 0.0).astype(np.float32)
-        xm, mm, xx = block_sum(r * m), block_sum(m * m), block_sum(r * r)
-        known = block_sum(keep.astype(np.float32))
-
-        def beta(m):
-            """Regression of the frame's relative texture on the learnt one over blocks ``m`` and
-            its standard error (pixels counted a quarter: interpolation and the codec correlate them)."""
-            smm, sxm, sxx, n = (float(np.sum(a[m], dtype=np.float64)) for a in (mm, xm, xx, known))
-            if smm <= 0.0 or n < MIN_KNOWN * side * side:
-                return 0.0, np.inf
-            b = sxm / smm
-            resid = max(sxx - b * sxm, 0.0) / n
-            return b, float(np.sqrt(4.0 * resid / smm))
-
-        b0, se0 = beta(calm)
-        registrable = b0 > K_TEX * se0 and b0 > 0.0
-        # per block, the mean relative fine energy of its known pixels (most must be known)
-        measured = known >= side * side / 2
-        energy = np.where(measured, xx / np.maximum(known, 1.0), np.float32(1e30)) * np.maximum(ratio, 1.0)
-        e0 = float(np.median(energy[calm & measured])) if (calm & measured).any() else 0.0
-        n, labels = cv2.connectedComponents(changed.astype(np.uint8), connectivity=8)
-        out = np.zeros_like(hit)
-        sharp = []
-        for k in range(1, n):
-            region = labels == k
-            if not (hit & region).any():
-                continue
-            b, se = beta(region)
-            lost = registrable and b < KEPT * b0 and (KEPT * b0 - b) > K_TEX * se
-            flat = e0 > 0.0 and float(np.percentile(energy[region], FLAT_SHARE)) < FLAT * e0
-            lit = region & (self._bg_b >= COLOUR_LEVEL)  # darker, a ratio is its quantisation and noise
-            colour = chroma is not None and int(lit.sum()) >= COLOUR_BLOCKS and float(np.median(
-                np.hypot(*(chroma[:, lit] - self._bg_c[:, lit])))) > COLOUR
-            if self.trace is not None:
-                self.trace.append({"t": round(t, 3), "blocks": int(region.sum()), "hits": int((hit & region).sum()),
-                                   "beta": b, "se": se, "beta_calm": b0, "se_calm": se0,
-                                   "flat": float(np.min(energy[region])) / e0 if e0 > 0 else None,
-                                   "colour": None if chroma is None else float(np.median(
-                                       np.hypot(*(chroma[:, region] - self._bg_c[:, region])))),
-                                   "ratio": float(np.median(ratio[region])), "object": bool(lost or flat or colour),
-                                   "e_q": [float(x) for x in np.percentile(energy[region], [10, 25, 50])] if e0 > 0 else None,
-                                   "e0": e0, "known": float(known[region].sum()) / (side * side),
-                                   "colour_calm": None if chroma is None or not calm.any() else float(np.median(
-                                       np.hypot(*(chroma[:, calm] - self._bg_c[:, calm])))),
-                                   "level": float(np.median(self._bg_b[region]))})
-            if lost or flat or colour:
-                out |= hit & region
-            else:
-                sharp.append(region)
-        if sharp and int(out.sum()) < MIN_MOVER_BLOCKS:
-            self._mark_note("sharp light", t)
-        return out
 
     def _mark_note(self, kind: str, t: float) -> None:
         self._mark(kind, t, self.note_spans)

@@ -1,0 +1,159 @@
+"""The view check's images: a frame's luma downscaled or sampled (native integer codes to float32
+on the 0-255 scale), the block grid it is judged on, the noise of a difference, and the filters
+that split a frame into bands (fine structure, registration band, broad light)."""
+from __future__ import annotations
+
+import numpy as np
+
+from wallcli.signal.view_limits import BLOCKS
+
+
+def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """A plane (native integer codes) as float32 at ``size`` (w, h). A large plane is halved by
+    2x2 area averages in its own integer type while it stays at least twice the size (OpenCV's
+    2x2 path takes 0.07 ms for 1080p; rounding there adds 0.3 codes of noise to averages whose
+    noise the thresholds measure anyway), then brought to ``size`` bilinearly: the last factor is
+    under 2, and OpenCV's area resize for such factors took three times the rest together."""
+    import cv2
+
+    while a.dtype in (np.uint8, np.uint16) and a.shape[1] >= 2 * size[0] and a.shape[0] >= 2 * size[1]:
+        h, w = a.shape
+        a = cv2.resize(a[:h - h % 2, :w - w % 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA)
+    a = a.astype(np.float32)
+    if a.shape[::-1] == tuple(size):
+        return a
+    fast = a.shape[1] < 2 * size[0] and a.shape[0] < 2 * size[1]
+    return cv2.resize(a, size, interpolation=cv2.INTER_LINEAR if fast else cv2.INTER_AREA)
+
+
+def _crop(a: np.ndarray, roi) -> np.ndarray:
+    if roi is None:
+        return a
+    x, y, w, h = roi
+    c = a[y:y + h, x:x + w]
+    return c if min(c.shape) >= 8 else a  # a bad ROI is the reader's error to give
+
+
+def _sampled_luma(planes, roi, max_side: int) -> np.ndarray:
+    """Luma of the frame (or its ROI) on the 0-255 scale, float32, one pixel in every ``step`` on
+    each axis so that the long side has at most ``max_side`` samples (OpenCV's nearest-neighbour
+    gather: a tenth of the cost of a strided copy, and no area resize of the whole plane)."""
+    import cv2
+
+    y = _crop(planes.y, roi)
+    h, w = y.shape
+    step = max(1, -(-max(h, w) // max_side))
+    size = (max(1, w // step), max(1, h // step))
+
+    def sample(a):
+        a = a if step == 1 else cv2.resize(a[: size[1] * step, : size[0] * step], size, interpolation=cv2.INTER_NEAREST)
+        return a.astype(np.float32)
+
+    scale = np.float32(1 << (planes.depth - 8))
+    y = sample(y)
+    if planes.kind == "rgb":
+        g, b = sample(_crop(planes.u, roi)), sample(_crop(planes.v, roi))
+        return (np.float32(0.299) * y + np.float32(0.587) * g + np.float32(0.114) * b) / scale
+    y /= scale
+    if not planes.full_range:
+        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
+    return y
+
+
+def _grey(planes, roi, max_side: int) -> tuple[np.ndarray, int]:
+    """Luma of the frame (or its ROI) as float32 on the 0-255 scale, at most ``max_side`` pixels
+    on its long side (what the wall's level is judged on), and the source width it stands for."""
+    def crop(a):
+        return _crop(a, roi)
+
+    Y = crop(planes.y)
+    h, w = Y.shape
+    s = min(1.0, max_side / max(h, w))
+    size = (max(1, round(w * s)), max(1, round(h * s)))
+    scale = float(1 << (planes.depth - 8))
+    if planes.kind == "rgb":
+        y = (0.299 * _shrink(Y, size) + 0.587 * _shrink(crop(planes.u), size) + 0.114 * _shrink(crop(planes.v), size)) / scale
+        return y.astype(np.float32), w
+    y = _shrink(Y, size) / np.float32(scale)
+    if not planes.full_range:
+        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
+    return y, w
+
+
+def _robust_sigma(d: np.ndarray) -> float:
+    """Sigma of one image from a difference of two: the RMS of the smallest 90 % of |d| (of the
+    differences the codec coded, see _coded), scaled to a Gaussian's. Not the median: H.264
+    repeats static blocks exactly, so most differences of a compressed wall are 0 and the median
+    says 'no noise'; the trimmed tail keeps a mover out."""
+    d = np.ravel(d)
+    if d.size == 0:
+        return 0.0
+    if d.size > 4096:  # a fixed stride of the image: as good an estimate for a tenth of the sorting
+        d = d[:: d.size // 2048]
+    d = _coded(d)
+    a = np.abs(d - _upper_median(d))
+    k = int(0.9 * (a.size - 1))
+    keep = np.partition(a, k)[:k + 1]  # partitions, not numpy's median and quantile: a tenth of the time
+    return float(np.sqrt(np.mean(keep * keep, dtype=np.float64) / 0.623 / 2.0))
+
+
+def _block_side(shape) -> int:
+    """Pixels per (square) block: BLOCKS blocks along the long side, at least 4 along the short."""
+    return max(1, min(max(shape) // BLOCKS, min(shape) // 4))
+
+
+def _whole_blocks(img: np.ndarray) -> np.ndarray:
+    """The centre of ``img`` that whole blocks tile (a few rows or columns at most are left out):
+    block means then take OpenCV's integer-factor area path, ten times faster than its general one."""
+    side = _block_side(img.shape)
+    h, w = img.shape
+    dh, dw = h % side, w % side
+    return img[dh // 2: h - (dh - dh // 2), dw // 2: w - (dw - dw // 2)]
+
+
+def _coded(d: np.ndarray) -> np.ndarray:
+    """The differences a codec actually coded: where most of a compressed wall is repeated exactly
+    from the frame before (H.264 skip blocks: at CRF 28 nearly all of it), the noise is what the
+    updated blocks show, not the zeros, which made every threshold built on it nothing and had
+    still walls refused as moving (2-3 of 12 walls at CRF 28)."""
+    nz = d[d != 0]
+    return nz if d.size // 2 > nz.size >= 16 else d
+
+
+def _upper_median(x: np.ndarray) -> float:
+    k = x.size // 2
+    return float(np.partition(x, k)[k])
+
+
+def _highpass(img: np.ndarray, sigma: float = 4.0) -> np.ndarray:
+    import cv2
+
+    return img - cv2.GaussianBlur(img, (0, 0), sigma)
+
+
+
+def _rms_known(a: np.ndarray) -> float:
+    """RMS of the finite values of ``a``; infinite (no bound) when there are none."""
+    a = a[np.isfinite(a)]
+    return float(np.sqrt(np.mean(a * a))) if a.size else np.inf
+
+
+
+def _broad_blur(img: np.ndarray, sigma: float) -> np.ndarray:
+    """A Gaussian blur of large ``sigma`` computed at a quarter of the size (what it keeps has no
+    detail finer than that) and brought back bilinearly: a tenth of the cost of the full kernel."""
+    import cv2
+
+    h, w = img.shape
+    if sigma < 6.0 or min(h, w) < 32:
+        return cv2.GaussianBlur(img, (0, 0), sigma)
+    small = cv2.resize(img, (max(1, w // 4), max(1, h // 4)), interpolation=cv2.INTER_AREA)
+    small = cv2.GaussianBlur(small, (0, 0), np.sqrt(max(sigma ** 2 - 4.0, 1.0)) / 4.0)
+    return cv2.resize(small, (w, h), interpolation=cv2.INTER_LINEAR)
+
+
+def _pixels(mask: np.ndarray, shape) -> np.ndarray:
+    """A block mask at pixel resolution (the block grid tiles ``shape``: see _whole_blocks)."""
+    import cv2
+
+    return cv2.resize(mask.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_NEAREST).astype(bool)
