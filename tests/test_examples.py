@@ -21,6 +21,9 @@ CLIPS = sorted(EXAMPLES.glob("*.mp4"))
 KNOWN_WRONG = {
     ("count", "standing"): "count 0.4.1 says 1 (the still person's sway shows in the plot; see the README)",
     ("count", "two-mixed"): "count 0.4.1 says 1",
+    # the two-stage count's prior odds of two people against one (1:4, the share of two-person rooms
+    # in the footage the models are validated for) outweigh the count net's 0.73 for two here
+    ("count", "two-walking"): "two-stage count with its 1:4 prior says 1 (count net alone: 2, p = 0.73)",
 }
 
 

@@ -108,7 +108,8 @@ def main(argv=None) -> int:
         block["two_fold"] = {"decided": cv_n, "right": cv_k, "clips": len(clips),
                              "how": "thresholds fitted on alternate clips, decided answers counted on the others, both ways"}
         block["in_sample"] = {"decided": n, "right": k}
-        card["two_stage"] = {"rule": RULE, "activity_model": act.info(), "confidence": block}
+        # the rest of the block (prior_two_vs_one, simulator figures) is kept
+        card["two_stage"] = dict(card.get("two_stage") or {}, rule=RULE, activity_model=act.info(), confidence=block)
         write_card(Path(a.count).with_suffix(".json"), card)
         print(f"wrote two_stage block into the card of {a.count}")
     return 0

@@ -28,11 +28,16 @@ import numpy as np
 BANDS = (("empty", None, None), ("<0 dB", None, 0.0), ("0-10 dB", 0.0, 10.0), (">=10 dB", 10.0, None))
 
 
+TWO_ODDS = [1.0]
+
+
 def two_stage(pc: np.ndarray, pa: np.ndarray) -> np.ndarray:
-    """Count answers (n,) from count probabilities (n, 3) and activity probabilities (n, 5)."""
-    a, b = pc[:, 0], pa[:, 0]
-    nobody = a * b / np.maximum(a * b + (1 - a) * (1 - b), 1e-12)
-    return np.where(nobody > 0.5, 0, np.where(pc[:, 1] >= pc[:, 2], 1, 2))
+    """Count answers (n,) from count probabilities (n, 3) and activity probabilities (n, 5), as
+    `wallcli count` answers them (wallcli/infer/twostage.py; --two-odds: the prior odds of two
+    people against one)."""
+    from wallcli.infer.twostage import combine
+
+    return combine(pc, pa, TWO_ODDS[0]).argmax(1)
 
 
 def band_of(people: int, snr) -> str:
@@ -111,7 +116,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("answers", nargs="*")
     ap.add_argument("--sim", action="append", default=[])
+    ap.add_argument("--two-odds", type=float, default=1.0)
     a = ap.parse_args(argv)
+    TWO_ODDS[0] = a.two_odds
     for p in a.answers:
         from_answers(p)
     for s in a.sim:

@@ -25,6 +25,22 @@ def test_combine_is_a_product_of_experts_then_the_count_nets_share():
     assert p.argmax(1).tolist() == [0, 2, 2]
 
 
+def test_the_prior_odds_of_two_people_move_only_the_second_stage():
+    pc = np.array([[0.1, 0.35, 0.55]])
+    pa = np.array([[0.2, 0.2, 0.2, 0.2, 0.2]])
+    even, prior = combine(pc, pa), combine(pc, pa, 0.25)
+    assert even.argmax() == 2 and prior.argmax() == 1  # 0.55 x 0.25 against 0.35
+    assert prior[0, 0] == pytest.approx(even[0, 0])  # presence is the first stage's alone
+    assert prior[0, 2] / prior[0, 1] == pytest.approx(0.25 * 0.55 / 0.35)
+
+
+def test_the_shipped_card_states_its_prior_and_where_it_comes_from():
+    from wallcli.infer.twostage import load_count
+
+    m = load_count()
+    assert 0 < m.two_odds < 1 and "labels" in m.card["two_stage"]["prior_source"]
+
+
 def test_a_person_the_count_net_misses_is_found_by_the_activity_net():
     # the count net leans to nobody (a croucher it cannot see in the horizontal plot); the activity
     # net, which reads both plots, is sure somebody moves: the two-stage count answers one

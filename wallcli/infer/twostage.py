@@ -8,7 +8,11 @@ reads as nobody. The activity net reads both plots. So:
   p(none)); their evidence is combined as a product of experts with even priors,
   p_nobody = a b / (a b + (1 - a)(1 - b));
 - stage 2, how many: the rest of the probability is shared between one and two people as the
-  count net shares it, p(n) = (1 - p_nobody) c_n / (c_1 + c_2).
+  count net shares it, p(n) = (1 - p_nobody) w_n c_n / (c_1 + w_2 c_2), with w_2 the prior odds of
+  two people against one (the card's ``two_stage.prior_two_vs_one``; the net was trained on even
+  classes, w_2 = 1). The shipped card sets 1:4, the share of two-person rooms among occupied ones
+  in the footage the models are validated for (the transfer set's labels: 20 of 100): most rooms
+  with somebody in them hold one person, and a net trained on even odds says "two" too often.
 
 The rule was fixed before any measurement (research/twostage/README.md, session 15): nothing in
 it is fitted. On the transfer set it moved count from 50 to 57 of 96 detectable clips there
@@ -29,20 +33,26 @@ import numpy as np
 from wallcli.errors import WallcliError
 
 RULE = ("presence: product of experts of the count net's p(0) and the activity net's p(none), even priors; "
-        "how many: the count net's p(1) against p(2)")
+        "how many: the count net's p(1) against p(2), weighted by the prior odds of two people against one")
 NO_PAIR_REASON = ("no validated confidence thresholds for this pair of count and activity models "
                   "(the count card's two_stage block names another activity model, or none)")
 
 
-def combine(pc: np.ndarray, pa: np.ndarray) -> np.ndarray:
-    """(n, 3) count probabilities from the count net's (n, 3) and the activity net's (n, 5)."""
+def combine(pc: np.ndarray, pa: np.ndarray, two_odds: float = 1.0) -> np.ndarray:
+    """(n, 3) count probabilities from the count net's (n, 3) and the activity net's (n, 5).
+
+    ``two_odds``: the prior odds of two people against one where somebody moves, in the footage
+    the answers are for. The count net was trained on even classes, so its share c2 / (c1 + c2)
+    is a posterior under even odds; Bayes' rule moves it to another prior by weighting c2 by the
+    odds (1: the net's own even prior)."""
     pc = np.asarray(pc, np.float64)
     pa = np.asarray(pa, np.float64)
     a, b = pc[:, 0], pa[:, 0]
     den = a * b + (1 - a) * (1 - b)
     nobody = np.where(den > 0, a * b / np.maximum(den, 1e-300), 0.5)
-    some = np.maximum(pc[:, 1] + pc[:, 2], 1e-300)
-    out = np.stack([nobody, (1 - nobody) * pc[:, 1] / some, (1 - nobody) * pc[:, 2] / some], axis=1)
+    c1, c2 = pc[:, 1], pc[:, 2] * float(two_odds)
+    some = np.maximum(c1 + c2, 1e-300)
+    out = np.stack([nobody, (1 - nobody) * c1 / some, (1 - nobody) * c2 / some], axis=1)
     return out / out.sum(axis=1, keepdims=True)
 
 
@@ -68,6 +78,10 @@ class TwoStageCount:
         self.card["confidence"] = block.get("confidence") if self.calibrated else None
         self.card["two_stage"] = block
         self.path = count.path
+        # the prior odds of two people against one (the card's, fixed from the share of two-person
+        # rooms in the footage it was validated for; 1 = the count net's own even prior)
+        odds = block.get("prior_two_vs_one", 1.0)
+        self.two_odds = float(odds) if isinstance(odds, (int, float)) and not isinstance(odds, bool) and odds > 0 else 1.0
 
     task = "count"
     single = False
@@ -94,7 +108,7 @@ class TwoStageCount:
 
     def combine(self, raw: np.ndarray) -> np.ndarray:
         raw = np.atleast_2d(raw)
-        return combine(raw[:, :3], raw[:, 3:])
+        return combine(raw[:, :3], raw[:, 3:], self.two_odds)
 
     def no_block_reason(self) -> str | None:
         return None if self.calibrated else NO_PAIR_REASON
@@ -104,10 +118,10 @@ class TwoStageCount:
         raw = np.asarray(raw, np.float64)
         p = self.combine(raw)[0]
         somebody = float(1 - p[0])
-        some = max(float(raw[1] + raw[2]), 1e-300)
         return {"presence": round(somebody, 6),
-                # stage 2: one or two people, given somebody moves (the count net's share)
-                "how_many": [round(float(raw[1]) / some, 6), round(float(raw[2]) / some, 6)],
+                # stage 2: one or two people, given somebody moves (the count net's share, under
+                # the card's prior odds of two against one)
+                "how_many": [round(float(p[1]) / max(somebody, 1e-300), 6), round(float(p[2]) / max(somebody, 1e-300), 6)],
                 "count": [round(float(v), 6) for v in raw[:3]],
                 "activity": [round(float(v), 6) for v in raw[3:]],
                 # the stage that made the label: nobody is the presence stage's answer, one or two
@@ -119,7 +133,8 @@ def stages_info(model) -> dict[str, Any] | None:
     """The result's description of a two-stage model (None for a single model)."""
     if not isinstance(model, TwoStageCount):
         return None
-    return {"rule": RULE, "activity_model": model.activity.info(), "calibrated": model.calibrated}
+    return {"rule": RULE, "activity_model": model.activity.info(), "calibrated": model.calibrated,
+            "prior_two_vs_one": model.two_odds}
 
 
 def load_count(path=None, *, activity_path=None, threads: int = 0, single: bool = False):
