@@ -1,0 +1,78 @@
+"""Repeated frames (a DVR's nominal-rate padding) found in the decode and left out as missing samples.
+
+A DVR that records fewer frames than its nominal rate fills the gaps with copies of the previous
+frame. A copy carries no new noise: its frame difference is zero, so the frame-difference noise
+estimate (half the mean square of consecutive differences) falls with the share of copies and
+the SNR reads too high; and the copies hold the light still for a frame, a stair in the time
+base. Dropping them, timestamps too, leaves the frames that were really captured, at the times
+they were captured; the resampling onto the analysis grid interpolates over the gap as over any
+variable frame rate.
+
+A repeat is a frame whose luma differs from the previous frame's by under ``REL`` of the clip's
+own typical frame-to-frame difference (a codec may re-encode a copy with a tiny residue; a real
+frame's sensor noise keeps the difference near its typical value). The typical value is the
+median of the recent frames that were not repeats and differed at all, so a clip whose frames
+never differ (noise-free synthetic video) has no typical value and nothing is ever dropped.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import Iterator
+
+import numpy as np
+
+REL = 0.1  # a repeat's difference is under a tenth of the clip's typical one
+HISTORY = 16  # recent real differences whose median is the typical one
+MIN_HISTORY = 4  # real differences seen before anything is called a repeat
+MAX_SAMPLES = 1 << 17  # luma pixels compared per frame (a lattice over larger frames)
+
+
+def _sample(y: np.ndarray) -> np.ndarray:
+    step = max(1, int(np.ceil(np.sqrt(y.size / MAX_SAMPLES))))
+    return y[::step, ::step]
+
+
+class RepeatFilter:
+    """A reader whose :meth:`frames` leaves out repeated frames; everything else is the reader's.
+
+    Memory: one sampled luma plane, whatever the length. ``decoded`` counts every frame read,
+    ``repeats`` those left out.
+    """
+
+    def __init__(self, reader) -> None:
+        self.reader = reader
+        self.decoded = 0
+        self.repeats = 0
+        self._prev = None
+        self._recent: deque = deque(maxlen=HISTORY)
+
+    def __getattr__(self, name: str):
+        return getattr(self.reader, name)
+
+    def is_repeat(self, y: np.ndarray) -> bool:
+        """Judge one frame's luma plane against the previous one's (and remember it)."""
+        cur = _sample(y)
+        prev, self._prev = self._prev, cur.astype(np.int32)
+        if prev is None or prev.shape != cur.shape:
+            return False
+        d = float(np.mean(np.abs(self._prev - prev)))
+        if len(self._recent) >= MIN_HISTORY and d < REL * float(np.median(self._recent)):
+            return True
+        if d > 0:
+            self._recent.append(d)
+        return False
+
+    def frames(self) -> Iterator:
+        for frame in self.reader.frames():
+            self.decoded += 1
+            if self.is_repeat(frame.planes.y):
+                self.repeats += 1
+                continue
+            yield frame
+
+    def correction(self) -> dict | None:
+        """The ``corrections`` entry (docs/contract.md), None when no frame was a repeat."""
+        if not self.repeats:
+            return None
+        return {"kind": "duplicates", "frames": int(self.repeats), "share": round(self.repeats / max(self.decoded, 1), 4)}
