@@ -292,6 +292,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     """
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
+    from wallcli.signal.repeats import RepeatFilter
     from wallcli.signal.view import ViewCheck
 
     classifier = WindowClassifier(model, stride, corrections=corrections)
@@ -302,7 +303,9 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
         for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
-        rows = RowStream(FrameTee(reader, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
+        # repeats (a DVR's padding) are missing samples: no tap, row or time sees them
+        unique = RepeatFilter(reader)
+        rows = RowStream(FrameTee(unique, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
                          progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.light,
                          register=corrections.shake)
         for t, row in rows:
@@ -312,7 +315,9 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
         if classifier.windower.last() is None:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model)
-    result = with_view(classifier.result(str(source), frames=rows.frames), check)
+    result = with_view(classifier.result(str(source), frames=unique.decoded), check)
+    if unique.correction():
+        result["corrections"].append(unique.correction())
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 

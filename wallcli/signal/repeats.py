@@ -25,6 +25,7 @@ import numpy as np
 REL = 0.1  # a repeat's difference is under a tenth of the clip's typical one
 HISTORY = 16  # recent real differences whose median is the typical one
 MIN_HISTORY = 4  # real differences seen before anything is called a repeat
+LOOKAHEAD = 12  # frames held at the start at most, while the typical difference is not yet known
 MAX_SAMPLES = 1 << 17  # luma pixels compared per frame (a lattice over larger frames)
 
 
@@ -50,13 +51,17 @@ class RepeatFilter:
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
 
-    def is_repeat(self, y: np.ndarray) -> bool:
-        """Judge one frame's luma plane against the previous one's (and remember it)."""
-        cur = _sample(y)
-        prev, self._prev = self._prev, cur.astype(np.int32)
+    def _difference(self, y: np.ndarray) -> float | None:
+        """Mean absolute luma difference from the previous frame (None for the first)."""
+        cur = _sample(y).astype(np.int32)
+        prev, self._prev = self._prev, cur
         if prev is None or prev.shape != cur.shape:
+            return None
+        return float(np.mean(np.abs(cur - prev)))
+
+    def _judge(self, d: float | None) -> bool:
+        if d is None:
             return False
-        d = float(np.mean(np.abs(self._prev - prev)))
         if len(self._recent) >= MIN_HISTORY and d < REL * float(np.median(self._recent)):
             return True
         if d > 0:
@@ -64,9 +69,31 @@ class RepeatFilter:
         return False
 
     def frames(self) -> Iterator:
+        # The first frames wait (at most LOOKAHEAD, holding their decoded buffers) until the
+        # clip's typical difference is known, so that a copy among them is found too
+        waiting: list = []
         for frame in self.reader.frames():
             self.decoded += 1
-            if self.is_repeat(frame.planes.y):
+            d = self._difference(frame.planes.y)
+            if waiting is None:
+                if self._judge(d):
+                    self.repeats += 1
+                    continue
+                yield frame
+                continue
+            waiting.append((frame, d))
+            if d:
+                self._recent.append(d)
+            if len(self._recent) >= MIN_HISTORY or len(waiting) >= LOOKAHEAD:
+                yield from self._release(waiting)
+                waiting = None
+        if waiting:
+            yield from self._release(waiting)
+
+    def _release(self, waiting: list) -> Iterator:
+        typical = float(np.median(self._recent)) if len(self._recent) >= MIN_HISTORY else None
+        for frame, d in waiting:
+            if typical is not None and d is not None and d < REL * typical:
                 self.repeats += 1
                 continue
             yield frame
