@@ -97,3 +97,22 @@ def test_repeat_filter_streams_and_finds_copies_among_the_first_frames():
     kept = [fr.time for fr in f.frames()]
     assert kept == [i / 30 for i in range(60) if not copy[i]]
     assert f.correction() == {"kind": "duplicates", "frames": 7, "share": round(7 / 60, 4)}
+
+
+def test_too_short_quotes_the_files_frames_copies_included(tmp_path, run_cli):
+    from wallcli.cli.app import main
+
+    clip = tmp_path / "short.mkv"
+    with pytest.raises(SystemExit):
+        main(["simulate", "-o", str(clip), "--people", "0", "--seed", "2", "--size", "64x48", "--duration", "3",
+              "--dup-frames", "0.3"])
+    assert json.loads(clip.with_suffix(".json").read_text())["duplicated"] > 0
+    code, _, err = run_cli("count", clip)
+    assert code != 0 and "90 frame(s) decoded" in err
+
+
+def test_dup_frames_is_refused_for_a_dataset_and_out_of_range(tmp_path, run_cli):
+    code, _, err = run_cli("simulate", "--dataset", "2", "-o", tmp_path / "d", "--dup-frames", "0.2")
+    assert code != 0 and "--dup-frames" in err
+    code, _, err = run_cli("simulate", "-o", tmp_path / "x.mkv", "--dup-frames", "0.7")
+    assert code != 0 and "--dup-frames" in err
