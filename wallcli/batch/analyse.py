@@ -97,5 +97,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     for task in TASKS:
         if task in out and unique.correction():
             out[task]["corrections"].append(unique.correction())
+    if "snr" in out and unique.correction():  # as wallcli snr: the file's frames
+        out["snr"]["frames"] = unique.decoded
     out["corrections"] = next((out[t]["corrections"] for t in TASKS if t in out), [])
     return out

@@ -194,8 +194,9 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     notes += [str(w.message) for w in caught]
     result = snr_report(acc, source=input, fps=fps, notes=notes,
                         roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))
-    if unique.correction():
+    if unique.correction():  # "frames" stays the file's; the entry says how many the estimator left out
         result["corrections"].append(unique.correction())
+        result["frames"] = unique.decoded
     result["view"] = check.summary()
     if strict:
         from wallcli.cli.common import refuse_view

@@ -22,7 +22,8 @@ from typing import Iterator
 
 import numpy as np
 
-REL = 0.1  # a repeat's difference is under a tenth of the clip's typical one
+REL = 0.01  # a repeat differs by under 1 % of the clip's typical difference (a low-noise clip's codec
+# skips its noise in whole blocks: real frames there differed by 3 % of the typical one)
 HISTORY = 16  # recent real differences whose median is the typical one
 MIN_HISTORY = 4  # real differences seen before anything is called a repeat
 LOOKAHEAD = 12  # frames held at the start at most, while the typical difference is not yet known
