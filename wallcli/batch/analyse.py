@@ -53,7 +53,6 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     if len({(m.bins, m.fps) for m in used}) > 1:
         raise WallcliError("the count and activity models read plots of different bins or frame rates; "
                            "one decode cannot feed both")
-    state = {"frames": 0, "last": 0.0}
     corrections = corrections if corrections is not None else Options()
     with open_video(source, threads=decoder_threads) as reader:
         info = reader.info
@@ -66,8 +65,6 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
             check(frame)
             if snr is not None:
                 snr.update(frame.planes)
-            state["frames"] += 1
-            state["last"] = frame.time
             if on_frame is not None:
                 on_frame()
 
@@ -88,7 +85,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
                 pass
         fps = float(info.fps)
         notes = list(reader.warnings)
-    out: dict[str, Any] = {"frames": unique.decoded, "duration": round(state["last"] + 1.0 / fps, 6), "fps": fps,
+    out: dict[str, Any] = {"frames": unique.decoded, "duration": round(unique.last_time + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes, "view": check.summary()}
     for task, c in zip(classify, classifiers):
         out[task] = with_view(c.result(source, frames=unique.decoded), check)

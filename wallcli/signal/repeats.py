@@ -38,7 +38,8 @@ def _sample(y: np.ndarray) -> np.ndarray:
 class RepeatFilter:
     """A reader whose :meth:`frames` leaves out repeated frames; everything else is the reader's.
 
-    Memory: one sampled luma plane, whatever the length. ``decoded`` counts every frame read,
+    Memory: one sampled luma plane, and up to LOOKAHEAD decoded frames at the start, whatever
+    the length. ``decoded`` counts every frame read,
     ``repeats`` those left out.
     """
 
@@ -46,6 +47,7 @@ class RepeatFilter:
         self.reader = reader
         self.decoded = 0
         self.repeats = 0
+        self.last_time = 0.0  # of the last frame decoded, a repeat or not
         self._prev = None
         self._recent: deque = deque(maxlen=HISTORY)
 
@@ -75,6 +77,7 @@ class RepeatFilter:
         waiting: list = []
         for frame in self.reader.frames():
             self.decoded += 1
+            self.last_time = frame.time
             d = self._difference(frame.planes.y)
             if waiting is None:
                 if self._judge(d):
