@@ -44,6 +44,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.corrections import Options
+    from wallcli.signal.repeats import RepeatFilter
     from wallcli.signal.snr import SnrAccumulator, snr_report
     from wallcli.signal.view import ViewCheck
 
@@ -52,7 +53,6 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     if len({(m.bins, m.fps) for m in used}) > 1:
         raise WallcliError("the count and activity models read plots of different bins or frame rates; "
                            "one decode cannot feed both")
-    state = {"frames": 0, "last": 0.0}
     corrections = corrections if corrections is not None else Options()
     with open_video(source, threads=decoder_threads) as reader:
         info = reader.info
@@ -65,12 +65,12 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
             check(frame)
             if snr is not None:
                 snr.update(frame.planes)
-            state["frames"] += 1
-            state["last"] = frame.time
             if on_frame is not None:
                 on_frame()
 
-        tee = _Tee(reader, each)
+        # repeats (a DVR's padding) are missing samples for every analysis of this decode
+        unique = RepeatFilter(reader)
+        tee = _Tee(unique, each)
         classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections, native_fps=float(info.fps))
                        for m in used]
         if classifiers:
@@ -85,11 +85,16 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
                 pass
         fps = float(info.fps)
         notes = list(reader.warnings)
-    out: dict[str, Any] = {"frames": state["frames"], "duration": round(state["last"] + 1.0 / fps, 6), "fps": fps,
+    out: dict[str, Any] = {"frames": unique.decoded, "duration": round(unique.last_time + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes, "view": check.summary()}
     for task, c in zip(classify, classifiers):
-        out[task] = with_view(c.result(source, frames=state["frames"]), check)
+        out[task] = with_view(c.result(source, frames=unique.decoded), check)
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
+    for task in TASKS:
+        if task in out and unique.correction():
+            out[task]["corrections"].append(unique.correction())
+    if "snr" in out and unique.correction():  # as wallcli snr: the file's frames
+        out["snr"]["frames"] = unique.decoded
     out["corrections"] = next((out[t]["corrections"] for t in TASKS if t in out), [])
     return out

@@ -91,6 +91,9 @@ def simulate(
                                                      "bands that travel down the frame (0 = global shutter, the default)."),
     ae_steps: Optional[int] = number_option(None, "--ae-steps", lo=0, hi=10, integer=True, help="Number of auto-exposure steps (each 0.5-3 %)."),
     shake: Optional[float] = number_option(None, "--shake", lo=0, hi=5, help="Camera shake, rms pixels (sub-pixel, e.g. 0.1)."),
+    dup_frames: Optional[float] = number_option(None, "--dup-frames", lo=0, hi=0.5, help="Share of frames replaced by an exact "
+                                                "copy of the frame before, in runs of 1-3, as a DVR pads to its nominal rate "
+                                                "(the sidecar says how many: duplicated)."),
     nuisances: float = number_option(0.0, "--nuisances", lo=0, hi=1, help="Probability that random drift/flicker/AE steps/shake "
                                     "are switched on (explicit options above always apply)."),
     preview: Optional[Path] = typer.Option(None, "--preview", help="Also draw the room from above with the paths beside the "
@@ -146,6 +149,8 @@ def simulate(
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
         if crf is not None:  # each scene's camera draws its own codec and quality from --domain
             raise UsageError("--crf applies to one video; a --dataset's scenes draw their compression from --domain")
+        if dup_frames:
+            raise UsageError("--dup-frames applies to one video, not to a --dataset")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
                         json_out, placement, spp, draws)
     if world == "mixed":
@@ -178,8 +183,10 @@ def simulate(
 
 def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, world, domain, dist, spd, level, iso_gain,
            read_noise, sensor_pixels, prnu, gamma, noise_scale, drift, flicker, mains, ae_steps, shake, nuisances,
-           preview, json_out, force, acts, suffix, spp, rolling_shutter=None, **_):
+           preview, json_out, force, acts, suffix, spp, rolling_shutter=None, dup_frames=None, **_):
     import json
+
+    import numpy as np
 
     from wallcli.cli.output import progress
     from wallcli.io.writer import VideoWriter, atomic_paths, check_outputs, committed_together
@@ -212,6 +219,10 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
             require()  # a missing extra is one clear error before any output is opened
         scene = sample_scene(seed, cfg)
     n = len(scene.times)
+    from wallcli.sim.dvr import dup_mask, pad_frames
+
+    # its own stream of the seed: the same seed with and without --dup-frames renders the same frames
+    copies = dup_mask(n, float(dup_frames or 0.0), np.random.default_rng([seed, 0xD0B]))
     pix_fmt = video_pix_fmt(scene.camera) if suffix != ".y4m" else None
     # video and ground truth appear together or not at all (the sidecar is renamed first, so a
     # video that is there always has its truth beside it)
@@ -220,11 +231,13 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         with VideoWriter(tmp_video, fps, w, h, codec=None if codec == "rawvideo" else codec, crf=crf,
                          pix_fmt=pix_fmt, repeatable=True) as vw:
             with progress("simulate", n) as advance:
-                for frame in scene.frames():
+                for frame in pad_frames(scene.frames(), copies):
                     vw.write(frame)
                     advance(1)
         truth = scene.truth()
         truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
+        if dup_frames:
+            truth.update(dup_frames=float(dup_frames), duplicated=int(copies.sum()))
         tmp_truth.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
         _finish(output, tmp_video, sidecar, truth, preview, json_out, force)
     from wallcli.cli.output import wrote

@@ -135,6 +135,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
+    from wallcli.signal.repeats import RepeatFilter
     from wallcli.signal.snr import SnrAccumulator, snr_db, snr_report
     from wallcli.signal.snr_map import GridAccumulator
     from wallcli.signal.view import ViewCheck
@@ -154,7 +155,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
             grid = GridAccumulator(full, 16, covariance=True)
             whole = ViewCheck()  # where the view fails (a mover, clipping) is no place for the ROI
             with progress("snr: finding the ROI", reader.info.frame_count) as advance:
-                for frame in reader.frames():
+                for frame in RepeatFilter(reader).frames():
                     grid.update(frame.planes)
                     whole(frame)
                     advance()
@@ -180,8 +181,10 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
             grid = GridAccumulator(roi_c, 48)
         feed_grid = grid if (grid is not None and not auto) else None
         check = ViewCheck(roi_c)
+        # a repeated frame (a DVR's padding) is a missing sample: its zero difference is no noise
+        unique = RepeatFilter(reader)
         with progress("snr", reader.info.frame_count) as advance:
-            for frame in reader.frames():
+            for frame in unique.frames():
                 acc.update(frame.planes)
                 check(frame)
                 if feed_grid is not None:
@@ -191,6 +194,9 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     notes += [str(w.message) for w in caught]
     result = snr_report(acc, source=input, fps=fps, notes=notes,
                         roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))
+    if unique.correction():  # "frames" stays the file's; the entry says how many the estimator left out
+        result["corrections"].append(unique.correction())
+        result["frames"] = unique.decoded
     result["view"] = check.summary()
     if strict:
         from wallcli.cli.common import refuse_view

@@ -33,11 +33,11 @@ def _too_short(source: str, frames: int, model, fps: float | None = None) -> Wal
         f"one window needs {model.window} frames at {model.fps:g} fps ({model.window / model.fps:.2f} s)")
 
 
-def _too_short_video(source: str, check, model) -> WallcliError:
+def _too_short_video(source: str, check, model, frames: int | None = None) -> WallcliError:
     """The too-short error of a video: the frames quoted are the file's (not the rows resampled to
     the model's rate), and the view check's verdict on them goes with it (``view`` on the error,
     and in its line): a clip too short to answer may still be no view of a wall."""
-    n, fps = check.seen, check.fps
+    n, fps = (check.seen if frames is None else frames), check.fps  # frames: the file's, repeats too
     view = check.summary()
     said = "usable" if view["usable"] else view["reason"]
     need = f"{model.window / model.fps:.2f} s"
@@ -292,6 +292,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     """
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
+    from wallcli.signal.repeats import RepeatFilter
     from wallcli.signal.view import ViewCheck
 
     classifier = WindowClassifier(model, stride, corrections=corrections)
@@ -302,7 +303,9 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
         for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
-        rows = RowStream(FrameTee(reader, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
+        # repeats (a DVR's padding) are missing samples: no tap, row or time sees them
+        unique = RepeatFilter(reader)
+        rows = RowStream(FrameTee(unique, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
                          progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.light,
                          register=corrections.shake)
         for t, row in rows:
@@ -311,8 +314,10 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             classifier.push(t, stream_row(row, rows), rows.ref)
         if classifier.windower.last() is None:
             check.fps = float(reader.info.fps or 0.0) or None
-            raise _too_short_video(str(source), check, model)
-    result = with_view(classifier.result(str(source), frames=rows.frames), check)
+            raise _too_short_video(str(source), check, model, unique.decoded)
+    result = with_view(classifier.result(str(source), frames=unique.decoded), check)
+    if unique.correction():
+        result["corrections"].append(unique.correction())
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
@@ -360,12 +365,15 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     """
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import RowStream
+    from wallcli.signal.repeats import RepeatFilter
     from wallcli.signal.view import ViewCheck
 
     windower = StreamWindower(model.window, stride)
     check = ViewCheck(roi)
     with open_video(source, threads=threads) as reader:
-        rows = RowStream(FrameTee(reader, (check,)), roi=roi, bins=model.bins, fps=model.fps,
+        # repeats left out as in classify_video (a line lists no corrections of the clip's)
+        unique = RepeatFilter(reader)
+        rows = RowStream(FrameTee(unique, (check,)), roi=roi, bins=model.bins, fps=model.fps,
                          vertical="vertical" in model.input_names or corrections.light, register=corrections.shake)
         for t, row in rows:
             done = windower.push(t, stream_row(row, rows))
@@ -376,4 +384,4 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
                 yield judge_view(rec, check.view(rec["start"], rec["end"]))
         if windower.count < model.window:
             check.fps = float(reader.info.fps or 0.0) or None
-            raise _too_short_video(str(source), check, model)
+            raise _too_short_video(str(source), check, model, unique.decoded)
