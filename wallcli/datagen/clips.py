@@ -146,11 +146,6 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
                    windows: int = 3, grid: tuple[int, int] = (24, 32), tmpdir: str | None = None,
                    camera_overrides: dict | None = None, placement: str = "visible", spp: int = 256) -> dict:
     """All windows of scene ``index``: arrays (k, BINS, WINDOW, 3) + labels + the scene's parameters."""
-    from wallcli.io.video import open_video
-    from wallcli.io.writer import VideoWriter
-    from wallcli.signal.stplot import compute_stplot
-    from wallcli.signal.window import resample
-
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), int(index), 7]))
     people, acts, label = scene_plan(rng, task, domain)
     if world == "mixed":
@@ -170,6 +165,22 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         scene = sample_scene(seed, cfg, index=index)
         scene.clean_profiles = []
     cam = scene.camera
+    plot = recorded_plot(scene.frames(), cam, tmpdir)
+    truth = scene.truth()
+    meta = {k: truth[k] for k in ("people", "activity", "activities", "fps", "frames", "width", "height", "domain")}
+    meta.update(seed=int(seed), index=int(index), world=world, camera=truth["camera"],
+                room=truth.get("room"), distance_m=[round(float(np.median(np.array(p["positions"])[:, 1])), 2) for p in truth["persons"]])
+    return cut_windows(plot, cam, rng, windows, scene, label=label, people=len(acts),
+                       activity=ACTIVITIES.index(truth["activity"]), info=meta)
+
+
+def recorded_plot(frames, cam, tmpdir: str | None = None):
+    """The space-time plot of ``frames`` (uint8 RGB) as camera ``cam`` records them: a real video
+    file (its codec, CRF and chroma), read back through the real stplot path."""
+    from wallcli.io.video import open_video
+    from wallcli.io.writer import VideoWriter
+    from wallcli.signal.stplot import compute_stplot
+
     suffix = ".mkv" if cam.codec == "ffv1" else ".mp4"
     fd, name = tempfile.mkstemp(suffix=suffix, dir=tmpdir)
     os.close(fd)
@@ -177,26 +188,29 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
     try:
         with VideoWriter(path, cam.fps, cam.width, cam.height, codec=cam.codec, crf=cam.crf,
                          pix_fmt=video_pix_fmt(cam), preset="veryfast", repeatable=True) as w:
-            for frame in scene.frames():
+            for frame in frames:
                 w.write(frame)
         with open_video(path) as reader:
-            plot = compute_stplot(reader, bins=BINS)
+            return compute_stplot(reader, bins=BINS)
     finally:
         path.unlink(missing_ok=True)
+
+
+def cut_windows(plot, cam, rng, windows: int, profiles, *, label: int, people: int, activity: int, info: dict) -> dict:
+    """A recorded plot's training windows (k, BINS, WINDOW, 3) at FPS, their labels, their measured
+    visibility (``profiles``: what :func:`_window_snr_db` reads, the clean profiles of the scene) and
+    ``info`` per window, as a dataset shard holds them."""
+    from wallcli.signal.window import resample
+
     h, t = resample(plot.horizontal, plot.time, FPS)
     v, _ = resample(plot.vertical, plot.time, FPS)
     starts = _window_starts(h.shape[1], windows, rng)
-    snr, snr_weakest = _window_snr_db(scene, cam, h, t, starts)
-    truth = scene.truth()
-    meta = {k: truth[k] for k in ("people", "activity", "activities", "fps", "frames", "width", "height", "domain")}
-    meta.update(seed=int(seed), index=int(index), world=world, camera=truth["camera"],
-                room=truth.get("room"), distance_m=[round(float(np.median(np.array(p["positions"])[:, 1])), 2) for p in truth["persons"]])
-    activity = ACTIVITIES.index(truth["activity"])
+    snr, snr_weakest = _window_snr_db(profiles, cam, h, t, starts)
     return {
         "horizontal": np.stack([h[:, s : s + WINDOW] for s in starts]).astype(np.float32),
         "vertical": np.stack([v[:, s : s + WINDOW] for s in starts]).astype(np.float32),
         "label": np.full(len(starts), label, np.int64),
-        "people": np.full(len(starts), len(acts), np.int64),
+        "people": np.full(len(starts), people, np.int64),
         "activity": np.full(len(starts), activity, np.int64),
         "snr_db": snr,
         "snr_db_weakest": snr_weakest,
@@ -204,5 +218,5 @@ def render_windows(seed: int, index: int, task: str, *, domain: str = "base", wo
         # normalisation v3 needs to tell a whole-wall light change from a person
         "h_offset": np.repeat(plot.h_mean[None].astype(np.float32), len(starts), axis=0),
         "v_offset": np.repeat(plot.v_mean[None].astype(np.float32), len(starts), axis=0),
-        "scenes": [dict(meta, window_start_s=round(s / FPS, 3)) for s in starts],
+        "scenes": [dict(info, window_start_s=round(s / FPS, 3)) for s in starts],
     }

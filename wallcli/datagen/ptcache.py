@@ -177,15 +177,9 @@ def compose_windows(arrays: dict, meta: dict, draw: int, *, windows: int = 4, tm
     """Windows of one cached scene under camera draw ``draw``: a fresh camera (noise, gain, tone
     curve, vignetting, codec, lighting nuisances) at the scene's frame rate, a real video file, and
     the real stplot path, exactly as :func:`wallcli.datagen.clips.render_windows` makes them."""
-    from wallcli.datagen.clips import BINS, _window_snr_db, _window_starts
-    from wallcli.io.video import open_video
-    from wallcli.io.writer import VideoWriter
-    from wallcli.signal.stplot import compute_stplot
-    from wallcli.signal.window import resample
-    from wallcli.sim.camera import Camera, sample_camera, video_pix_fmt
+    from wallcli.datagen.clips import cut_windows, recorded_plot
+    from wallcli.sim.camera import Camera, sample_camera
     from wallcli.sim.motion import ACTIVITIES
-
-    import tempfile
 
     rec = meta["recipe"]
     rng = np.random.default_rng(np.random.SeedSequence([rec["seed"], meta["index"], 11, int(draw)]))
@@ -197,38 +191,11 @@ def compose_windows(arrays: dict, meta: dict, draw: int, *, windows: int = 4, tm
     E0, dE = arrays["E0"], arrays["dE"]
     T = len(dE)
     camera = Camera(cam, E0, arrays["wall_albedo"], T, rng)
-    suffix = ".mkv" if cam.codec == "ffv1" else ".mp4"
-    fd, name = tempfile.mkstemp(suffix=suffix, dir=tmpdir)
-    os.close(fd)
-    path = Path(name)
-    try:
-        with VideoWriter(path, cam.fps, cam.width, cam.height, codec=cam.codec, crf=cam.crf,
-                         pix_fmt=video_pix_fmt(cam), preset="veryfast", repeatable=True) as w:
-            for i in range(T):
-                w.write(camera.render(dE[i], i, static_E=E0))
-        with open_video(path) as reader:
-            plot = compute_stplot(reader, bins=BINS)
-    finally:
-        path.unlink(missing_ok=True)
-    h, t = resample(plot.horizontal, plot.time, FPS)
-    v, _ = resample(plot.vertical, plot.time, FPS)
-    starts = _window_starts(h.shape[1], windows, rng)
-    snr, weakest = _window_snr_db(_Profiles(arrays, meta), cam, h, t, starts)
-    activity = ACTIVITIES.index(meta["activity"])
+    plot = recorded_plot((camera.render(dE[i], i, static_E=E0) for i in range(T)), cam, tmpdir)
     info = {"seed": rec["seed"], "index": meta["index"], "draw": int(draw), "world": "pt", "spp": rec["spp"],
             "people": meta["people"], "activity": meta["activity"], "activities": meta["activities"],
             "fps": cam.fps, "frames": T, "width": cam.width, "height": cam.height, "domain": domain,
             "camera": cam.to_dict(), "room": meta["room"],
             "distance_m": [round(float(np.median(np.array(p["positions"])[:, 1])), 2) for p in meta["persons"]]}
-    return {
-        "horizontal": np.stack([h[:, s:s + WINDOW] for s in starts]).astype(np.float32),
-        "vertical": np.stack([v[:, s:s + WINDOW] for s in starts]).astype(np.float32),
-        "label": np.full(len(starts), meta["label"], np.int64),
-        "people": np.full(len(starts), meta["people"], np.int64),
-        "activity": np.full(len(starts), activity, np.int64),
-        "snr_db": snr,
-        "snr_db_weakest": weakest,
-        "h_offset": np.repeat(plot.h_mean[None].astype(np.float32), len(starts), axis=0),
-        "v_offset": np.repeat(plot.v_mean[None].astype(np.float32), len(starts), axis=0),
-        "scenes": [dict(info, window_start_s=round(s / FPS, 3)) for s in starts],
-    }
+    return cut_windows(plot, cam, rng, windows, _Profiles(arrays, meta), label=meta["label"], people=meta["people"],
+                       activity=ACTIVITIES.index(meta["activity"]), info=info)
