@@ -4,6 +4,15 @@
 # calibrate them on a simulated validation set, and pack the models for the way back.
 # Nothing here is needed to reproduce the shipped models on a CPU: models/train.sh does that (slowly).
 #
+# Session 20 (issue 35, point 7): path-traced clean scenes for the cache (wallcli/datagen/ptcache.py),
+# rendered with Mitsuba's CUDA variant at a sample count whose Monte-Carlo noise is under a third of
+# a camera's, packed for the way back (64 MiB a call), composed and trained on here. The wheels:
+# mitsuba 3.9.1 and drjit 1.5.0 for cp312, slimmed (research/pathtrace/slim_wheel.py --variants
+# cuda_ad_rgb,scalar_rgb), in .whl/ (git-ignored), carried as `.whl`.
+#
+#   bash research/transfer/device_run.sh pt       # install, render for RENDER s in the background, pack what is done
+#   bash research/transfer/device_run.sh ptmore   # the next call, on the same warm machine: wait, pack the rest
+#
 #   bash research/transfer/device_run.sh gen     # start simulating in the background (setsid), wait a while
 #   bash research/transfer/device_run.sh train   # wait for the data, train 4 nets at once, pack them into $OUT
 #   bash research/transfer/device_run.sh wait    # keep waiting on whatever runs (resumable training)
@@ -40,7 +49,34 @@ net() {  # name task arch extra...
     > "$D/train_$name.log" 2>&1 < /dev/null &
 }
 
+ptprogress() {
+  echo "[$SECONDS s] scenes: $(ls /tmp/ptc/pt/*/scene-*.npz 2>/dev/null | wc -l); $(tail -1 /tmp/fill.log 2>/dev/null | cut -c1-160)"
+}
+
 case "${1:-}" in
+  pt)
+    SPP=${SPP:-4096}; PTSEED=${PTSEED:-2000}; RENDER=${RENDER:-560}; WAIT=${WAIT:-400}
+    python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target .site .whl/*.whl || exit 4
+    export PYTHONPATH=$PWD/.site:$PYTHONPATH WALLCLI_CACHE=/tmp/ptc WALLCLI_PT_VARIANT=cuda_ad_rgb OMP_NUM_THREADS=1
+    nvidia-smi -L
+    python3 -c "import mitsuba as mi; mi.set_variant('cuda_ad_rgb'); print('mitsuba', mi.__version__, mi.variant())" || exit 5
+    setsid python3 research/ptcache/fill.py --seed "$PTSEED" --start 0 --stop 5000 --jobs "$JOBS" --spp "$SPP" \
+      --budget "$RENDER" > /tmp/fill.log 2>&1 < /dev/null &
+    setsid python3 research/ptcache/spp_noise.py --scenes 8 --frames 40 --ref 16384 --spps 512,1024,2048,4096 \
+      > /tmp/noise.log 2>&1 < /dev/null &
+    while [ $SECONDS -lt "$WAIT" ]; do sleep 30; ptprogress; done
+    python3 research/ptcache/pack.py --root /tmp/ptc/pt --out "$OUT" --ledger /tmp/packed.txt --tag a --total-mib 60
+    cat /tmp/noise.log; cp /tmp/fill.log /tmp/noise.log "$OUT"/ 2>/dev/null
+    exit 0
+    ;;
+  ptmore)
+    WAIT=${WAIT:-120}
+    while [ $SECONDS -lt "$WAIT" ] && pgrep -f ptcache/fill.py > /dev/null; do sleep 10; done
+    ptprogress
+    python3 research/ptcache/pack.py --root /tmp/ptc/pt --out "$OUT" --ledger /tmp/packed.txt --tag b --total-mib 60
+    cat /tmp/noise.log; cp /tmp/fill.log /tmp/noise.log "$OUT"/ 2>/dev/null
+    exit 0
+    ;;
   gen)
     setsid bash -c "$W simulate --dataset $NV --task count --domain wide --placement wide --seed 32 -o $D/val32 --jobs $JOBS \
       && $W simulate --dataset $N --task count --domain wide --placement wide --seed 31 -o $D/wide31 --jobs $JOBS \

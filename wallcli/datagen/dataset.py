@@ -17,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from wallcli.datagen.clips import BINS, COUNT_ACTS, FPS, WINDOW, render_windows
+from wallcli.datagen.ptcache import FORMAT as PT_FORMAT, VERSION as PT_VERSION
 from wallcli.sim.motion import ACTIVITIES
 
 FORMAT, VERSION = "wallcli.dataset", 1
@@ -35,7 +36,7 @@ def recipe(task, seed, n, domain, world, windows_per_scene, shard_scenes, grid, 
     if world == "pt":  # path traced: its sample count is part of the data (other worlds' recipes unchanged)
         rec["spp"] = int(spp)
         # clean scenes from the cache (datagen/ptcache.py), each under `draws` fresh cameras
-        rec["clean_cache"] = {"format": "wallcli.pt-clean-scene", "version": 1, "draws": int(draws)}
+        rec["clean_cache"] = {"format": PT_FORMAT, "version": PT_VERSION, "draws": int(draws)}
     if task == "count":  # the movers' activity mix (a dataset made with another mix is another dataset)
         rec["count_activities"] = dict(zip(*COUNT_ACTS))
     return rec
