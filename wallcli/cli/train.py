@@ -139,7 +139,7 @@ def train(
     # the checkpoint is read and rewritten by every run of this training (no --force needed), but
     # it must not be one of the data's files, or the model's
     check_output(checkpoint or out.with_suffix(".ckpt.pt"), force=True, inputs=[*read, out, card_path(out)])
-    init_info = None
+    init_info = base = None
     if init is not None:
         from wallcli.infer.card import read_card, sha256_file
 
@@ -181,7 +181,8 @@ def train(
         name=name or f"wallcli-{task.value}", version=model_version, task=task.value, classes=ds.classes, stride=stride,
         preprocessing=prep, normalisation=NORMALIZATION_TEXT[prep],
         training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
-                       "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db},
+                       "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db,
+                       "windows_seen": _windows_seen(ds.manifests, base)},
         training={**({"init": init_info} if init_info else {}), "arch": arch, "seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
                   **({"lr_schedule": f"constant {cfg.lr:g}, then cosine to {cfg.lr * ANNEAL_FLOOR:g} over the last {anneal} epochs"}
                      if anneal else {}),
@@ -306,3 +307,9 @@ class _TrainProgress:
             acc = f"{f['train_accuracy']:.1%}" if f["train_accuracy"] is not None else "-"
             self.console.print(f"epoch {f['epoch']}: loss {loss} acc {acc}  "
                                f"{f['train_windows_per_s']:.1f} windows/s{val}")
+
+
+def _windows_seen(manifests: list, init_card: dict | None) -> dict:
+    from wallcli.train.provenance import windows_seen
+
+    return windows_seen(manifests, init_card)
