@@ -128,8 +128,8 @@ def table(args) -> None:
     kinds = sorted({e["kind"] for e in index.values()} - {"clean"})
     print("| kind | code | N | view usable kept | count label kept | activity label kept | "
           "count signal_db within 3 dB | activity signal_db within 3 dB | all four | median signal_db change (count) |"
-          " found |")
-    print("|" + "---|" * 11)
+          " found | decided on a figure over 3 dB off (count, activity) |")
+    print("|" + "---|" * 12)
     for kind in kinds:
         for tag in tags:
             rows = []
@@ -151,8 +151,10 @@ def table(args) -> None:
                         abs(a[t]["signal_db"] - c[t]["signal_db"]) <= 3 for t in ("count", "activity"))
                         for _, c, a in rows)
             found = sum(any(x["kind"] in _KINDS[kind] for x in a["corrections"]) for _, c, a in rows)
+            off = {t: sum(a[t]["confident"] and abs(a[t]["signal_db"] - c[t]["signal_db"]) > 3 for _, c, a in rows)
+                   for t in ("count", "activity")}
             print(f"| {kind} | {tag} | {n} | {view} | {lab['count']} | {lab['activity']} | {db['count']} | "
-                  f"{db['activity']} | {every} | {np.median(d['count']):+.1f} | {found} |")
+                  f"{db['activity']} | {every} | {np.median(d['count']):+.1f} | {found} | {off['count']}, {off['activity']} |")
     if args.detail:
         for kind in kinds:
             for tag in tags:

@@ -54,6 +54,16 @@ def white_balance(raws: list[np.ndarray], rate: float, part: np.ndarray | None =
     return np.exp(gains), found
 
 
+def balance(raws: list[np.ndarray], rate: float, part: np.ndarray | None = None) -> dict[str, Any] | None:
+    """:func:`white_balance`'s gains divided out of ``raws`` in place; its finding, or None."""
+    found = white_balance(raws, rate, part)
+    if found is None:
+        return None
+    for r in raws:
+        r /= found[0][None]
+    return found[1]
+
+
 def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
     """A clip's ``white_balance`` entry: each colour's largest amplitude over the windows, and in
     how many windows it was found."""
