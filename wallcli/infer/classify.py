@@ -293,9 +293,8 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
     from wallcli.signal.repeats import RepeatFilter
-    from wallcli.signal.view import ViewCheck
-
     from wallcli.signal.tnr import TemporalNoise, bound_result
+    from wallcli.signal.view import ViewCheck
 
     classifier = WindowClassifier(model, stride, corrections=corrections)
     thumb = PlotThumbnail() if keep_plot else None
@@ -370,9 +369,8 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import RowStream
     from wallcli.signal.repeats import RepeatFilter
-    from wallcli.signal.view import ViewCheck
-
     from wallcli.signal.tnr import TemporalNoise, bound_result
+    from wallcli.signal.view import ViewCheck
 
     windower = StreamWindower(model.window, stride)
     check = ViewCheck(roi)
