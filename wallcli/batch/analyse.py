@@ -46,6 +46,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     from wallcli.signal.corrections import Options
     from wallcli.signal.repeats import RepeatFilter
     from wallcli.signal.snr import SnrAccumulator, snr_report
+    from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
     classify = [t for t in CLASSIFY if t in tasks]
@@ -60,9 +61,11 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
                              fps=float(info.fps)) if "snr" in tasks else None
 
         check = ViewCheck()
+        blend = TemporalNoise()
 
         def each(frame) -> None:
             check(frame)
+            blend(frame)
             if snr is not None:
                 snr.update(frame.planes)
             if on_frame is not None:
@@ -88,7 +91,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     out: dict[str, Any] = {"frames": unique.decoded, "duration": round(unique.last_time + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes, "view": check.summary()}
     for task, c in zip(classify, classifiers):
-        out[task] = with_view(c.result(source, frames=unique.decoded), check)
+        out[task] = bound_result(with_view(c.result(source, frames=unique.decoded), check), blend.correction())
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
     for task in TASKS:

@@ -94,6 +94,13 @@ def simulate(
     dup_frames: Optional[float] = number_option(None, "--dup-frames", lo=0, hi=0.5, help="Share of frames replaced by an exact "
                                                 "copy of the frame before, in runs of 1-3, as a DVR pads to its nominal rate "
                                                 "(the sidecar says how many: duplicated)."),
+    tnr: Optional[float] = number_option(None, "--tnr", lo=0, hi=0.95, help="Temporal noise reduction as phones and DVRs "
+                                         "apply it on still scenes: each frame blended with the last output, "
+                                         "out = A prev + (1 - A) in (0.3-0.8 typical; the noise is then correlated "
+                                         "from frame to frame)."),
+    awb_drift: Optional[float] = number_option(None, "--awb-drift", lo=0, hi=0.2, help="Auto white balance hunting: slow "
+                                               "per-colour gains, each wandering its own way by up to this relative "
+                                               "amplitude (e.g. 0.01)."),
     nuisances: float = number_option(0.0, "--nuisances", lo=0, hi=1, help="Probability that random drift/flicker/AE steps/shake "
                                     "are switched on (explicit options above always apply)."),
     preview: Optional[Path] = typer.Option(None, "--preview", help="Also draw the room from above with the paths beside the "
@@ -149,8 +156,8 @@ def simulate(
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
         if crf is not None:  # each scene's camera draws its own codec and quality from --domain
             raise UsageError("--crf applies to one video; a --dataset's scenes draw their compression from --domain")
-        if dup_frames:
-            raise UsageError("--dup-frames applies to one video, not to a --dataset")
+        if dup_frames or tnr or awb_drift:
+            raise UsageError("--dup-frames, --tnr and --awb-drift apply to one video, not to a --dataset")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
                         json_out, placement, spp, draws)
     if world == "mixed":
@@ -183,7 +190,8 @@ def simulate(
 
 def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, world, domain, dist, spd, level, iso_gain,
            read_noise, sensor_pixels, prnu, gamma, noise_scale, drift, flicker, mains, ae_steps, shake, nuisances,
-           preview, json_out, force, acts, suffix, spp, rolling_shutter=None, dup_frames=None, **_):
+           preview, json_out, force, acts, suffix, spp, rolling_shutter=None, dup_frames=None, tnr=None, awb_drift=None,
+           **_):
     import json
 
     import numpy as np
@@ -196,7 +204,8 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
     check_outputs([output, sidecar, preview], force=force)
     overrides = {k: v for k, v in dict(level=level, gain=iso_gain, read_noise=read_noise, prnu=prnu, gamma=gamma, drift=drift,
                                          flicker=flicker, mains=mains, ae_steps=ae_steps, shake=shake,
-                                         rolling_shutter=rolling_shutter).items() if v is not None}
+                                         rolling_shutter=rolling_shutter, tnr=tnr, awb_drift=awb_drift).items()
+                 if v is not None}
     overrides["sensor_pixels"] = float(sensor_pixels) if sensor_pixels else float(w * h)
     codec = "ffv1" if suffix == ".mkv" else ("rawvideo" if suffix == ".y4m" else "libx264")
     if world == "flatland":

@@ -293,11 +293,13 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
     from wallcli.signal.repeats import RepeatFilter
+    from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
     classifier = WindowClassifier(model, stride, corrections=corrections)
     thumb = PlotThumbnail() if keep_plot else None
     check = ViewCheck(roi)
+    blend = TemporalNoise()
     with open_video(source, threads=threads) as reader:
         classifier.native_fps = float(reader.info.fps)
         for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
@@ -305,7 +307,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
                 tap.fps = float(reader.info.fps)
         # repeats (a DVR's padding) are missing samples: no tap, row or time sees them
         unique = RepeatFilter(reader)
-        rows = RowStream(FrameTee(unique, (check, *taps)), roi=roi, bins=model.bins, fps=model.fps,
+        rows = RowStream(FrameTee(unique, (check, blend, *taps)), roi=roi, bins=model.bins, fps=model.fps,
                          progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.light,
                          register=corrections.shake)
         for t, row in rows:
@@ -318,6 +320,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     result = with_view(classifier.result(str(source), frames=unique.decoded), check)
     if unique.correction():
         result["corrections"].append(unique.correction())
+    result = bound_result(result, blend.correction())  # a blended noise: signal_db an upper bound
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
 
@@ -366,14 +369,16 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import RowStream
     from wallcli.signal.repeats import RepeatFilter
+    from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
     windower = StreamWindower(model.window, stride)
     check = ViewCheck(roi)
+    blend = TemporalNoise()
     with open_video(source, threads=threads) as reader:
         # repeats left out as in classify_video (a line lists no corrections of the clip's)
         unique = RepeatFilter(reader)
-        rows = RowStream(FrameTee(unique, (check,)), roi=roi, bins=model.bins, fps=model.fps,
+        rows = RowStream(FrameTee(unique, (check, blend)), roi=roi, bins=model.bins, fps=model.fps,
                          vertical="vertical" in model.input_names or corrections.light, register=corrections.shake)
         for t, row in rows:
             done = windower.push(t, stream_row(row, rows))
@@ -381,7 +386,8 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
                 p, db, found = _predict_window(model, done[2], rows.ref, start=done[0], native=float(reader.info.fps),
                                                options=corrections)
                 rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
-                yield judge_view(rec, check.view(rec["start"], rec["end"]))
+                # what the frames so far say of the noise (a window holds 256 of them)
+                yield bound_result(judge_view(rec, check.view(rec["start"], rec["end"])), blend.correction())
         if windower.count < model.window:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)

@@ -57,9 +57,11 @@ class _Tee:
         self._reader, self._requested, self._corrections = reader, roi, corrections
         self.info = reader.info
         self.snr = self.grid = self.first = None
+        from wallcli.signal.tnr import TemporalNoise
         from wallcli.signal.view import ViewCheck
 
         self.view = ViewCheck(roi)
+        self.blend = TemporalNoise()  # a camera's temporal noise reduction (signal/tnr.py)
 
     @property
     def warnings(self) -> list[str]:
@@ -83,6 +85,7 @@ class _Tee:
             self.snr.update(planes)
             self.grid.update(planes)
             self.view(frame)
+            self.blend(frame)
             yield frame
 
 
@@ -129,6 +132,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     import warnings
 
     from wallcli.infer.classify import WindowClassifier, _thumb_plot, stream_row, with_view
+    from wallcli.signal.tnr import bound_result
     from wallcli.infer.stream import PlotThumbnail, RowStream
     from wallcli.io.video import open_video
     from wallcli.signal.corrections import Options
@@ -194,7 +198,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
                        snr_corrections=list(tee.snr.corrections))
     for task, c in classifiers.items():
         try:
-            out.results[task] = with_view(c.result(str(source), frames=rows.frames), tee.view)
+            out.results[task] = bound_result(with_view(c.result(str(source), frames=rows.frames), tee.view),
+                                             tee.blend.correction())
         except WallcliError as exc:  # too short for one window: the rest of the report still stands
             out.failures[task] = str(exc)
     return out

@@ -25,7 +25,7 @@ shape a person does not make:
 ``correct`` divides the found gains out and returns what was found; ``merge`` sums a clip's
 findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
 ``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``; a
-step that a window's end cut wherever it was seen, taken as a ramp there, carries ``"partial": True``).
+step cut by a window's end, taken as a ramp there, ``"partial": True``; ``white_balance``: :mod:`~.whitebalance`).
 Camera shake (``kind: "shake"``) is regressed out first, where the stream measured each frame's
 shift (:mod:`wallcli.signal.shake`, in :func:`correct_windows`).
 """
@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from wallcli.signal.exposure import _steps_and_drift, solve
+from wallcli.signal.whitebalance import balance, merge as merge_white_balance
 
 MAINS_HZ = (50.0, 60.0)
 MIN_LINE_HZ = 0.5  # slower aliases are drift's business
@@ -79,8 +80,6 @@ def mains_lines(native_fps: float | None, rate: float) -> list[float]:
         if f >= MIN_LINE_HZ and f < rate / 2 - SEARCH_HZ and all(abs(f - g) > 2 * SEARCH_HZ for g in out):
             out.append(f)
     return out
-
-
 
 
 # ------------------------------------------------------------------------------------ flicker
@@ -230,6 +229,10 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
             shaken = _unshake(raws, shifts[w])
             if shaken is not None:
                 found[w].append(shaken)
+        part = np.concatenate([np.full(r.shape[0], i) for i, r in enumerate(raws)])  # what differs between
+        # the colours first (white balance, divided out of raws), then the grey gain on what is left
+        balanced = balance(raws, rate, part) if options.exposure and raws[0].shape[1] >= MIN_SAMPLES else None
+        found[w] += [balanced] if balanced is not None else []
         # colours summed: the nuisances are grey; (T, K) with K the bins of every part used
         series = np.concatenate([r.sum(axis=-1).T for r in raws], axis=1)
         vs = None
@@ -237,9 +240,8 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
             start = sum(raws[i].shape[0] for i in range(used.index(vertical_index)))
             vs = slice(start, start + raws[used.index(vertical_index)].shape[0])
         t0 = 0.0 if starts is None else float(starts[w])
-        part = np.concatenate([np.full(r.shape[0], i) for i, r in enumerate(raws)])
         res = fit(series, rate, lines=lines, options=options, t0=t0, vertical=vs, part=part)
-        if res is None and shaken is None:
+        if res is None and shaken is None and balanced is None:
             continue
         pos = 0
         for k, raw in zip(used, raws):
@@ -306,6 +308,7 @@ def merge(per_window: list[list[dict]]) -> list[dict[str, Any]]:
     drift = [f["amplitude"] for fs in per_window for f in fs if f["kind"] == "drift"]
     if drift:
         out.append({"kind": "drift", "amplitude": round(float(max(drift)), 5), "windows": len(drift)})
+    out += merge_white_balance(per_window)
     shake = [f for fs in per_window for f in fs if f["kind"] == "shake"]
     if shake:
         out.append({"kind": "shake", "rms_px": round(float(np.median([f["rms_px"] for f in shake])), 3),

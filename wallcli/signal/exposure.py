@@ -219,7 +219,7 @@ def _open_ends(g, rel, w, basis, found, thr, noise, sigma, m, part) -> list[tupl
     return out
 
 
-def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarray, list, float]:  # noqa: C901
+def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIFT_DEGREE) -> tuple[np.ndarray, list, float]:  # noqa: C901,E501
     """(model of the whole-frame gain (T,), steps [(index, size)], drift peak-to-peak) of relative
     changes ``rel`` (T, K): a cubic plus steps fitted jointly to the median over the bins.
 
@@ -236,7 +236,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None) -> tuple[np.ndarra
     once all are found). Works on logarithms of the levels (:func:`fit`): gains add."""
     t = rel.shape[0]
     g = _robust_gain(rel)
-    basis = _legendre(t, DRIFT_DEGREE)
+    basis = _legendre(t, degree)  # degree: of the drift's polynomial
     dg = np.diff(g)
     noise = 1.4826 * np.median(np.abs(dg - np.median(dg))) / np.sqrt(2.0)
     db = np.diff(rel, axis=0)

@@ -5,6 +5,7 @@ Pipeline per frame (float64 until the last step, never rounded in between):
   x exposure (auto-exposure settles the clip's mean on ``level``) x light drift x mains flicker
   x auto-exposure steps; + sub-pixel shake (first-order shift of the static image);
   + photon shot noise (variance = code value x ``gain`` codes per electron) + read noise;
+  x optional white-balance gains per colour, optional temporal noise reduction (sim/isp.py);
   -> optional tone curve (gamma) -> round to 8 bits.
 
 Small frames stand for a larger sensor ROI: a (w x h) frame that images ``sensor_pixels``
@@ -20,6 +21,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from wallcli.sim import WIDE_DOMAINS
+from wallcli.sim.isp import RecursiveFilter, awb_gains
 
 NOISE_FLOOR = 0.35
 CLIP_GUARD = 235.0  # output code the brightest 0.5 % of the static wall may reach (headroom for AE steps)
@@ -52,6 +54,8 @@ class CameraParams:
     features: float = 0.0  # relative contrast of a door frame, a switch plate and a skirting
     # board on the wall (0: a plain wall): the structure a shaking camera's profiles move with
     noise_scale: float = 1.0  # user multiplier on all temporal noise
+    tnr: float = 0.0  # temporal noise reduction: each frame blended with the last, out = a prev + (1 - a) in
+    awb_drift: float = 0.0  # auto white balance hunting: relative amplitude of slow per-colour gains
 
     def to_dict(self) -> dict:
         return {k: (round(v, 6) if isinstance(v, float) else v) for k, v in asdict(self).items()}
@@ -217,6 +221,10 @@ class Camera:
         self.rng = rng
         self.row_gains = None  # (frames, H) flicker of a rolling shutter, else None
         self.gains, self.shifts = self._tracks(frames, rng)
+        # the ISP's stages (sim/isp.py) draw from a child stream: with and without them, a seed
+        # renders the same room, camera and noise
+        self.awb = awb_gains(frames, p.fps, p.awb_drift, rng.spawn(1)[0]) if p.awb_drift else None
+        self.tnr = RecursiveFilter(p.tnr) if p.tnr else None
 
     def upsample(self, E: np.ndarray) -> np.ndarray:
         """(gy, gx, 3) grid -> (H, 3, W) float32 image, bilinear."""
@@ -278,6 +286,10 @@ class Camera:
         if self.row_gains is not None:
             lin *= self.row_gains[index][:, None, None]
         lin += noise * np.float32(self.LUT_STEP)
+        if self.awb is not None:  # the ISP's gains apply to what the sensor read, noise and all
+            lin *= self.awb[index].astype(np.float32)[None, :, None]
+        if self.tnr is not None:
+            lin = self.tnr(lin)
         lin += np.float32(0.5)
         np.clip(lin, 0, len(self.lut) - 1, out=lin)
         return np.ascontiguousarray(self.lut[lin.astype(np.uint16)].transpose(0, 2, 1))
