@@ -274,6 +274,27 @@ def _finish(output, tmp_video, sidecar, truth, preview, json_out, force) -> None
             "persons": [{k: v for k, v in p.items() if k != "positions"} for p in truth.get("persons", [])]})
 
 
+def _say_uncached(n, task, seed, domain, placement, grid_rc, spp, wps, draws) -> None:
+    """Warn before a path-traced data set renders clean scenes here: a cache filled elsewhere (a
+    lent GPU) is only used by the same recipe, and a grid or sample count that differs from it
+    silently means hours of path tracing on the CPU."""
+    from wallcli.cli.output import console_err, warn
+    from wallcli.datagen import ptcache
+
+    rec = ptcache.recipe(seed=seed, task=task, domain=domain, placement=placement, grid=grid_rc, spp=spp)
+    needed = -(-(-(-n // wps)) // draws)
+    folder = ptcache.folder(rec)
+    missing = sum(1 for i in range(needed) if not ptcache.scene_file(rec, i).is_file())
+    if missing:
+        others = sorted(p.name for p in folder.parent.glob(f"{task}-{domain}-{placement}-s{seed}-*")) if folder.parent.is_dir() else []
+        warn(f"{missing} of the {needed} clean path-traced scenes are not in the cache "
+                          f"({folder}): they are rendered here first, at {spp} spp on a {grid_rc[0]}x{grid_rc[1]} grid"
+                          + (f"; the cache holds this seed under other recipes ({', '.join(others)}: another --grid "
+                             "or --spp?)" if others else ""))
+    else:
+        console_err.print(f"all {needed} clean path-traced scenes are cached ({folder})")
+
+
 def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid_rc, force, json_out, placement, spp=256,
              draws=1) -> None:
     import os
@@ -292,6 +313,7 @@ def _dataset(output, n, task, seed, jobs, domain, world, wps, shard_scenes, grid
 
         require()  # checked here, once, not in every worker
         jobs = jobs or 1  # Mitsuba already renders each frame on every core (or on the GPU)
+        _say_uncached(n, task, seed, domain, placement, grid_rc, spp, wps, draws)
     jobs = jobs or os.cpu_count() or 1
     t0 = time.perf_counter()
     with progress(f"dataset ({task})", n) as advance:
