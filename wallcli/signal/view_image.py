@@ -26,6 +26,20 @@ def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return cv2.resize(a, size, interpolation=cv2.INTER_LINEAR if fast else cv2.INTER_AREA)
 
 
+def _box_blocks(geometry, shape: tuple[int, int], boxes) -> np.ndarray:
+    """(rows, cols) bool: the blocks of the grid (ViewCheck._note_bad's ``geometry``) that overlap
+    any of ``boxes`` (x, y, w, h, source pixels)."""
+    out = np.zeros(shape, bool)
+    x0, y0, side, dh, dw, scale = geometry
+    for bx, by, bw, bh in boxes:
+        c0 = int(np.floor(((bx - x0) / scale - dw) / side))
+        c1 = int(np.ceil(((bx + bw - x0) / scale - dw) / side))
+        r0 = int(np.floor(((by - y0) / scale - dh) / side))
+        r1 = int(np.ceil(((by + bh - y0) / scale - dh) / side))
+        out[max(r0, 0):max(r1, 0), max(c0, 0):max(c1, 0)] = True
+    return out
+
+
 def _crop(a: np.ndarray, roi) -> np.ndarray:
     if roi is None:
         return a
