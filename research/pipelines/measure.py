@@ -126,6 +126,7 @@ def main() -> None:
     ap.add_argument("--min-snr", type=float, default=5.0)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--table", action="store_true", help="print the table from what is there")
+    ap.add_argument("-v", action="store_true", help="also list the cases not kept")
     a = ap.parse_args()
     chosen = clips(a.min_snr)
     alt_dir = a.out / "clips" / a.kind
@@ -155,7 +156,7 @@ def main() -> None:
         print(f"| {a.kind} | {a.tag} | {t} | {sum(x['usable'] for x in s)}/{n} | {sum(x['label'] for x in s)}/{n} | "
               f"{sum(x['db'] for x in s)}/{n} | {sum(x['kept'] for x in s)}/{n} | "
               f"{np.median(d) if d else float('nan'):.2f} |")
-    if "-v" in sys.argv or os.environ.get("VERBOSE"):
+    if a.v:
         for x in rows:
             if not x["kept"]:
                 print(json.dumps(x))

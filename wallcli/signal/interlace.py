@@ -1,15 +1,17 @@
 """Interlaced video found in the decode and its fields brought to one instant.
 
 An interlaced frame holds two fields: the even rows (the top field) captured at one instant and
-the odd rows (the bottom field) at another, half a frame interval later or earlier. Where the
-wall's light changes, the rows then alternate between the two instants (combing). Each field is
-compared with the other one interpolated to its rows, in the same frame and in the frames either
-side: with the bottom field ``delta`` frames after the top one, the bottom field of frame k
-resembles the top field of frame k + delta. In a progressive clip the two cross-frame comparisons
-(bottom of k against top of k + 1, and against top of k - 1) differ by noise alone, whatever the
-picture does; in an interlaced one, the one towards the later field's side is the closer. Their
-difference, frame by frame, decides (a t statistic over the frames, ``T_DECIDE``), and its size
-against the curvature of the three comparisons gives ``delta`` (about 1/2 for a camera's fields).
+the odd rows (the bottom field) at another, ``delta`` frame intervals later (earlier: negative).
+Where the wall's light changes, the rows then alternate between the two instants (combing): the
+bottom field over the top one interpolated to its rows, less one, is the wall's fixed texture
+(which a change of light scales, leaving the ratio) plus ``delta`` times the relative rate at
+which the light changes there. The rate is read on the top field, from the frames either side
+(whose noise is not the ratio's). Both, less their running means over ``TAU`` seconds (the fixed
+texture, and slow drifts that a static texture cannot be told from), are regressed on each
+other over every sample and frame: the slope is ``delta``, about 1/2 for a camera's fields and
+0 for a progressive clip, and its t statistic decides (``T_DECIDE``). A steady ramp of light
+moves the ratio by a constant, which the running mean takes out: only changes of the rate (a
+person moving, a shadow that comes and goes) tell, and a clip without them stays undecided.
 
 Once decided, every frame's bottom field is interpolated in time (between its own and the
 neighbouring frame's bottom field) to the top field's instant: each frame is then one instant, at
@@ -21,12 +23,14 @@ small to matter and may never be decided.
 from __future__ import annotations
 
 import dataclasses
+from collections import deque
 from typing import Iterator
 
 import numpy as np
 
 MAX_COLUMNS = 256  # luma columns compared (a lattice on wider frames); every row is read
-T_DECIDE = 8.0  # t statistic of the cross-frame asymmetry over the frames
+T_DECIDE = 8.0  # t statistic of the slope
+TAU = 1.0  # seconds: the running means' time constant
 MIN_FRAMES = 12
 MIN_DELTA = 0.3  # frames: a smaller offset between the fields is too small to correct
 OFFSETS = (-1.0, -0.5, 0.5, 1.0)  # what delta is snapped to (1/2: a camera's fields; 1: fields a frame apart)
@@ -40,9 +44,10 @@ class InterlaceFilter:
         self.reader = reader
         self.delta: float | None = None  # the bottom field's offset from the top one, frames
         self.since: float | None = None  # time of the first frame corrected
-        self._prev = None  # (top field interpolated to the bottom rows, bottom field) of the last frame
-        self._x: list[float] = []  # per frame: far-side minus near-side comparison (see the docstring)
-        self._sums = np.zeros(3)  # e0, e+, e- summed over the frames
+        self._seen: deque = deque(maxlen=5)  # (top field at the bottom rows, bottom field) of the last frames
+        self._mean = None  # running means of the ratio and the rate
+        self._n = 0
+        self._sums = np.zeros(6)  # sum xy, xx, yy, the samples, zy and zx, over the frames
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
@@ -52,34 +57,47 @@ class InterlaceFilter:
         a = np.asarray(y[:, ::step], np.float32)
         top, bottom = a[0::2], a[1::2]
         n = min(top.shape[0] - 1, bottom.shape[0])
-        return 0.5 * (top[:n] + top[1:n + 1]), bottom[:n]
+        return np.maximum(0.5 * (top[:n] + top[1:n + 1]), 1.0), bottom[:n]
 
-    def _observe(self, y: np.ndarray) -> None:
+    def _observe(self, y: np.ndarray, fps: float) -> None:
         if y.shape[0] < 8:
             return
         cur = self._fields(y)
-        prev, self._prev = self._prev, cur
-        if prev is None or prev[0].shape != cur[0].shape:
+        if self._seen and cur[0].shape != self._seen[-1][0].shape:
+            self._seen.clear()
+        self._seen.append(cur)
+        if len(self._seen) < 5:
             return
-        e0 = float(np.mean((cur[1] - cur[0]) ** 2))
-        ep = float(np.mean((prev[1] - cur[0]) ** 2))  # bottom of k-1 against top of k
-        em = float(np.mean((cur[1] - prev[0]) ** 2))  # bottom of k against top of k-1
-        self._sums += (e0, ep, em)
-        self._x.append(em - ep)
-        if self.delta is None and len(self._x) >= MIN_FRAMES and len(self._x) % 4 == 0:
+        (far0, _), (before, _), (top, bottom), (after, _), (far1, _) = self._seen
+        ratio = bottom / top - 1.0
+        rate = (after - before) / (2.0 * top)
+        wide = (far1 - far0) / (4.0 * top)  # the rate again, on other frames' noise
+        self._n += 1
+        a = max(1.0 / (TAU * fps), 1.0 / self._n)
+        if self._mean is None:
+            self._mean = [ratio, rate, wide]
+        else:
+            self._mean = [(1 - a) * m + a * v for m, v in zip(self._mean, (ratio, rate, wide))]
+        if self._n < 3:
+            return
+        yy, xx, zz = ratio - self._mean[0], rate - self._mean[1], wide - self._mean[2]
+        self._sums += (float(np.sum(xx * yy)), float(np.sum(xx * xx)), float(np.sum(yy * yy)), xx.size,
+                       float(np.sum(zz * yy)), float(np.sum(zz * xx)))
+        if self.delta is None and self._n >= MIN_FRAMES and self._n % 4 == 0:
             self._decide()
 
     def _decide(self) -> None:
-        x = np.asarray(self._x)
-        se = float(np.std(x, ddof=1)) / np.sqrt(x.size)
-        if se <= 0 or abs(float(x.mean())) < T_DECIDE * se:
+        sxy, sxx, syy, n, szy, szx = self._sums
+        if sxx <= 0 or szx <= 0:
             return
-        e0, ep, em = self._sums
-        curve = em + ep - 2 * e0
-        if curve <= 0:
+        slope = sxy / sxx  # the test: no slope unless the fields are two instants
+        se = np.sqrt(max(syy - slope * sxy, 0.0) / n / sxx)
+        if slope == 0 or (se > 0 and abs(slope) < T_DECIDE * se):
             return
-        delta = (em - ep) / (2 * curve)
-        if abs(delta) < MIN_DELTA:
+        # the size: the rate's own noise flattens the slope; measured against the rate read on
+        # other frames (whose noise is not the rate's nor the ratio's) it does not
+        delta = szy / szx
+        if abs(delta) < MIN_DELTA or np.sign(delta) != np.sign(slope):
             return
         self.delta = min(OFFSETS, key=lambda d: abs(d - delta))
 
@@ -107,8 +125,9 @@ class InterlaceFilter:
 
     def frames(self) -> Iterator:
         before = current = None
+        fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
         for frame in self.reader.frames():
-            self._observe(frame.planes.y)
+            self._observe(frame.planes.y, fps)
             if current is not None:
                 yield current if self.delta is None else self._align(before, current, frame)
             before, current = current, frame

@@ -10,7 +10,8 @@ box in the frames next to the step and is never taken for one.
 
 Text that never changes (a camera name, the clock's date) is found by the same freezing: samples
 that have not changed at all for ``STILL_RUN`` seconds, where the wall's own noise keeps most of
-the frame changing, and that stand out from their neighbourhood as a text's strokes do.
+the frame changing, that stand out from their neighbourhood as a text's strokes do, and most of
+which hold one code value (the text's colour).
 
 A box found is filled, from the frame before its first step on, with what that frame showed there,
 scaled by how the wall's light around the box has changed since: no analysis (the view check,
@@ -39,7 +40,12 @@ BEFORE, AFTER = 3, 2  # frame pairs either side of a step in which its box must 
 PAD = 2  # samples: a step's box widened by this before the pairs either side are read
 MAX_BOX = 0.08  # of the frame's area: an overlay's step (some digits), or a line of text, is no larger
 STILL_RUN = 0.5  # seconds a static text's samples have not changed at all
+STATIC_CONTRAST = 24.0  # 8-bit codes from their neighbourhood's median (a codec leaves wall texture still too)
+STATIC_PIXELS = 10  # such samples in a line of text
+FLAT, FLAT_SHARE = 3.0, 0.5  # and this share of them within this many codes of one value: a recorder's
+# text is drawn in one colour, a wall's texture never is
 MAX_STILL_SHARE = 0.5  # of the frame: where more is as still, stillness tells nothing (a codec's static blocks)
+MAX_FRAME_STEP = 0.03  # of the frame's samples changed at once: more is the whole picture stepping
 MAX_TOTAL = 0.2  # of the frame's area: boxes beyond it are not taken (the check judges the rest)
 MAX_REGIONS = 32
 RING = 3  # source pixels about a box whose light the box follows
@@ -96,7 +102,9 @@ class OverlayFilter:
             self._big.append(None)
             return
         d = np.abs(s - prev)
-        self._sig.append(1.4826 * float(np.median(d)))  # of a difference, robustly
+        # the noise of a difference: a codec zeroes most differences of a still wall, and the
+        # median alone then reads its noise as a fraction of what the rest of the pixels show
+        self._sig.append(max(1.4826 * float(np.median(d)), float(np.percentile(d, 90)) / 1.645))
         sigma = float(np.median(self._sig))
         big = d > max(K_STEP * sigma, ABS_STEP)
         still = d <= max(REL_FROZEN * sigma, 0.5)
@@ -114,8 +122,8 @@ class OverlayFilter:
 
         maps = {i: b for i, b in (e for e in self._big if e is not None)}
         big = maps.get(j)
-        if big is None or int(big.sum()) < MIN_PIXELS:
-            return []
+        if big is None or int(big.sum()) < MIN_PIXELS or big.mean() > MAX_FRAME_STEP:
+            return []  # (a cut, a flash, the camera jumping: the whole frame steps, no overlay)
         h, w = big.shape
         joined = cv2.dilate(big.astype(np.uint8), np.ones((3, 5), np.uint8))  # a text line's strokes
         n, _, stats, _ = cv2.connectedComponentsWithStats(joined, connectivity=8)
@@ -147,11 +155,11 @@ class OverlayFilter:
         if not long.any() or long.mean() > MAX_STILL_SHARE:
             return []
         s = self._prev
-        stands_out = np.abs(s - cv2.medianBlur(s, 5)) > self._contrast
+        stands_out = np.abs(s - cv2.medianBlur(s, 5)) > max(self._contrast, STATIC_CONTRAST)
         cand = long & stands_out
         if self._taken is not None and self._taken.shape == cand.shape:
             cand &= ~self._taken
-        if int(cand.sum()) < MIN_PIXELS:
+        if int(cand.sum()) < STATIC_PIXELS:
             return []
         h, w = cand.shape
         joined = cv2.dilate(cand.astype(np.uint8), np.ones((3, 5), np.uint8))
@@ -159,7 +167,11 @@ class OverlayFilter:
         found = []
         for x, y, bw, bh, _ in stats[1:n]:
             x0, y0, x1, y1 = max(x - PAD, 0), max(y - PAD, 0), min(x + bw + PAD, w), min(y + bh + PAD, h)
-            if int(cand[y0:y1, x0:x1].sum()) >= MIN_PIXELS and (x1 - x0) * (y1 - y0) <= MAX_BOX * h * w:
+            values = s[y0:y1, x0:x1][cand[y0:y1, x0:x1]]
+            if values.size < STATIC_PIXELS or (x1 - x0) * (y1 - y0) > MAX_BOX * h * w:
+                continue
+            mode = float(np.median(values))
+            if np.mean(np.abs(values - mode) <= FLAT) >= FLAT_SHARE:
                 found.append((x0, y0, x1, y1))
         return found
 

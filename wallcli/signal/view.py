@@ -89,7 +89,7 @@ class ViewCheck:
 
     def mask(self, box, first: float = 0.0) -> None:
         """The frames fed from now on have ``box`` (x, y, w, h, source pixels) masked: an overlay."""
-        self.masked.append((tuple(int(v) for v in box), float(first)))
+        self.masked.append((tuple(int(v) for v in box), round(float(first), 4)))
 
     def gap(self, start: float, end: float) -> None:
         """Frames are missing between ``start`` and ``end`` (the times of the frames either side)."""
