@@ -13,8 +13,8 @@ other over every sample and frame: the slope is ``delta``, about 1/2 for a camer
 moves the ratio by a constant, which the running mean takes out: only changes of the rate (a
 person moving, a shadow that comes and goes) tell, and a clip without them stays undecided.
 
-Once decided, every frame's bottom field is interpolated in time (between its own and the
-neighbouring frame's bottom field) to the top field's instant: each frame is then one instant, at
+Once decided, every frame's bottom field is moved in time to the top field's instant (see
+:meth:`InterlaceFilter._align`): each frame is then one instant, at
 the file's frame rate and times, every row where it was. Frames wait one frame (memory flat).
 Until the decision the frames pass as decoded: a clip whose light hardly changes has combing too
 small to matter and may never be decided.
@@ -102,22 +102,32 @@ class InterlaceFilter:
         self.delta = min(OFFSETS, key=lambda d: abs(d - delta))
 
     def _align(self, before, frame, after):
-        """``frame`` with its bottom field (odd rows, every plane) moved to its top field's instant."""
+        """``frame`` with its bottom field (odd rows, every plane) moved to its top field's instant.
+
+        Fields a whole frame apart are paired again (the bottom field of the frame before or
+        after). Half a frame apart, the bottom field is moved by the change the top field shows
+        over the frames either side (half of it, times the offset): an average of two bottom
+        fields would do the same for the light but halve their noise, and the noise estimate
+        read from frame differences would then read the clip 2-4 dB stronger than it is; this
+        adds a sixteenth of the noise's variance."""
         d = self.delta
-        other, w = (before, d) if d > 0 else (after, -d)  # weight of the neighbour's bottom field
-        if other is None:
+        near = (before if d > 0 else after) if abs(d) >= 1 else None
+        if (near is None and abs(d) >= 1) or (abs(d) < 1 and (before is None or after is None)):
             return frame
-        planes, near = frame.planes, other.planes
-        if near.y.shape != planes.y.shape:
+        planes = frame.planes
+        if any(o is not None and o.planes.y.shape != planes.y.shape for o in (before, after)):
             return frame
-        w = np.float32(min(w, 1.0))
         out = {}
         for name in ("y", "u", "v"):
             a = getattr(planes, name)
             if a is None:
                 continue
             a = a.astype(np.float32)
-            a[1::2] = (1 - w) * a[1::2] + w * np.asarray(getattr(near, name)[1::2], np.float32)
+            if near is not None:
+                a[1::2] = np.asarray(getattr(near.planes, name)[1::2], np.float32)
+            else:
+                rate = _top_at_bottom(getattr(after.planes, name)) - _top_at_bottom(getattr(before.planes, name))
+                a[1::2] -= np.float32(d / 2.0) * rate
             out[name] = a
         if self.since is None:
             self.since = round(float(frame.time), 4)
@@ -140,3 +150,11 @@ class InterlaceFilter:
             return None
         return {"kind": "interlace", "field_order": "tff" if self.delta > 0 else "bff",
                 "field_offset": self.delta, "from": self.since}
+
+
+def _top_at_bottom(a: np.ndarray) -> np.ndarray:
+    """The top field (even rows) of a plane, interpolated to the bottom field's rows."""
+    top = np.asarray(a[0::2], np.float32)
+    n = a[1::2].shape[0]
+    below = np.concatenate([top[1:n + 1], top[len(top) - 1:]])[:n] if n else top[:0]
+    return 0.5 * (top[:n] + below)

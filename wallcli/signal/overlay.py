@@ -96,6 +96,9 @@ class OverlayFilter:
         return y.astype(np.float32) / np.float32(1 << (planes.depth - 8))
 
     def _observe(self, planes) -> None:
+        if min(planes.y.shape) < 16:  # a frame too thin for a line of text (4000x16, 1x1000)
+            self._big.append(None)
+            return
         s = self._sample(planes)
         prev, self._prev = self._prev, s
         if prev is None or prev.shape != s.shape:

@@ -1,9 +1,10 @@
 """The decode as every analysis reads it: a camera pipeline's artefacts taken out, in one pass.
 
-Repeated frames (a DVR's padding) are left out (:mod:`wallcli.signal.repeats`), an interlaced
-clip's fields brought to one instant (:mod:`wallcli.signal.interlace`), and burned-in overlays
-masked (:mod:`wallcli.signal.overlay`), in that order: a copy is no step of a clock, and a clock's
-step is found on whole instants. Each keeps a few frames at most; memory stays flat.
+Repeated frames (a DVR's padding) are left out (:mod:`wallcli.signal.repeats`), burned-in
+overlays masked (:mod:`wallcli.signal.overlay`) and an interlaced clip's fields brought to one
+instant (:mod:`wallcli.signal.interlace`), in that order: a copy is no step of a clock, and a
+recorder's text, which does not follow the wall's light, would read as fields at two instants
+(its fill follows the light as the wall does). Each keeps a few frames at most; memory stays flat.
 """
 
 from __future__ import annotations
@@ -24,8 +25,8 @@ class CameraPipeline:
     def __init__(self, reader, check=None) -> None:
         self.reader = reader
         self.repeats = RepeatFilter(reader)
-        self.interlace = InterlaceFilter(self.repeats)
-        self.overlay = OverlayFilter(self.interlace, check)
+        self.overlay = OverlayFilter(self.repeats, check)
+        self.interlace = InterlaceFilter(self.overlay)
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
@@ -39,7 +40,7 @@ class CameraPipeline:
         return self.repeats.last_time
 
     def frames(self) -> Iterator:
-        return self.overlay.frames()
+        return self.interlace.frames()
 
     def corrections(self) -> list[dict]:
         """The ``corrections`` entries (docs/contract.md) of what was found and taken out."""
