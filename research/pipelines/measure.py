@@ -27,6 +27,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -95,8 +96,9 @@ def run(path: Path, task: str, dst: Path, code: str | None) -> dict:
     env = dict(os.environ)
     if code:
         env["PYTHONPATH"] = code
-    p = subprocess.run([sys.executable, "-m", "wallcli", task, str(path), "--json"], capture_output=True, text=True,
-                       env=env)
+    # run from elsewhere: ``python -m`` puts the working directory first on the path, before PYTHONPATH
+    p = subprocess.run([sys.executable, "-m", "wallcli", task, str(Path(path).resolve()), "--json"],
+                       capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
     try:
         r = json.loads(p.stdout)
     except json.JSONDecodeError:
@@ -115,6 +117,13 @@ def judge(clean: dict, alt: dict) -> dict:
     db = a is not None and b is not None and abs(a - b) <= 3.0
     return {"usable": usable, "label": label, "db": db, "kept": usable and label and db,
             "delta": None if a is None or b is None else round(b - a, 2)}
+
+
+def found(result: dict, kind: str) -> bool:
+    """Whether ``result`` lists the kind: an overlay in view.masked, interlace under corrections."""
+    if kind == "overlay":
+        return bool(result["view"].get("masked"))
+    return any(c.get("kind") == kind for c in result.get("corrections") or [])
 
 
 def main() -> None:
@@ -146,6 +155,7 @@ def main() -> None:
             if c.exists() and x.exists():
                 clean, alt = json.loads(c.read_text()), json.loads(x.read_text())
                 rows.append({"file": r["file"], "task": t, "snr_db": float(r["snr_db"]), **judge(clean, alt),
+                             "found": found(alt, a.kind), "false": found(clean, a.kind),
                              "view": alt["view"], "corr": [k.get("kind") for k in alt.get("corrections") or []]})
     for t in TASKS + ("both",):
         s = [x for x in rows if t in ("both", x["task"])]
@@ -155,7 +165,8 @@ def main() -> None:
         d = [abs(x["delta"]) for x in s if x["delta"] is not None]
         print(f"| {a.kind} | {a.tag} | {t} | {sum(x['usable'] for x in s)}/{n} | {sum(x['label'] for x in s)}/{n} | "
               f"{sum(x['db'] for x in s)}/{n} | {sum(x['kept'] for x in s)}/{n} | "
-              f"{np.median(d) if d else float('nan'):.2f} |")
+              f"{np.median(d) if d else float('nan'):.2f} | {sum(x['found'] for x in s)}/{n} | "
+              f"{sum(x['false'] for x in s)}/{n} |")
     if a.v:
         for x in rows:
             if not x["kept"]:

@@ -21,7 +21,7 @@ import numpy as np
 
 from wallcli.signal.view_cut import CutWatch
 from wallcli.signal.view_image import (
-    _block_side, _box_blocks, _broad_blur, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
+    _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
 )
 from wallcli.signal.view_light import _chroma, _objects, _relative_texture
 from wallcli.signal.view_limits import (
@@ -180,22 +180,10 @@ class ViewCheck:
         overlap a block where the view failed on some checked frame (clipped, too dark, or a
         moving object in it). A whole-frame failure (camera motion, a cut) marks no cell: no
         part of the frame escapes it."""
-        out = np.zeros((rows, cols), bool)
-        gx, gy, gw, gh = roi
-        cw, ch = gw / cols, gh / rows
         rects = [(x, x + w, y, y + h) for (x, y, w, h), _ in self.masked]  # an overlay's box is no wall
         if self._bad is not None and self._bad.any():
-            x0, y0, side, dh, dw, scale = self._bad_geometry
-            rects += [(x0 + (dw + j * side) * scale, x0 + (dw + (j + 1) * side) * scale,
-                       y0 + (dh + i * side) * scale, y0 + (dh + (i + 1) * side) * scale)
-                      for i, j in zip(*np.nonzero(self._bad))]
-        for bx0, bx1, by0, by1 in rects:
-            # the block's source rectangle, then the cells it overlaps (open intervals: a block
-            # that only touches a cell's edge leaves the cell alone)
-            c0, c1 = int(np.floor((bx0 - gx) / cw)), int(np.ceil((bx1 - gx) / cw))
-            r0, r1 = int(np.floor((by0 - gy) / ch)), int(np.ceil((by1 - gy) / ch))
-            out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
-        return out
+            rects += _block_rects(self._bad_geometry, np.nonzero(self._bad))
+        return _cells(rects, roi, rows, cols)
 
     def _reset(self, hp, small, blocks, planes, full) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first

@@ -40,6 +40,27 @@ def _box_blocks(geometry, shape: tuple[int, int], boxes) -> np.ndarray:
     return out
 
 
+def _block_rects(geometry, where) -> list:
+    """(x0, x1, y0, y1) source rectangles of the blocks at ``where`` (rows, cols) of the grid."""
+    x0, y0, side, dh, dw, scale = geometry
+    return [(x0 + (dw + j * side) * scale, x0 + (dw + (j + 1) * side) * scale,
+             y0 + (dh + i * side) * scale, y0 + (dh + (i + 1) * side) * scale) for i, j in zip(*where)]
+
+
+def _cells(rects, roi, rows: int, cols: int) -> np.ndarray:
+    """(rows, cols) bool: the cells of a grid over ``roi`` (x, y, w, h) that ``rects`` (x0, x1,
+    y0, y1, source pixels) overlap (open intervals: a rectangle that only touches a cell's edge
+    leaves the cell alone)."""
+    out = np.zeros((rows, cols), bool)
+    gx, gy, gw, gh = roi
+    cw, ch = gw / cols, gh / rows
+    for bx0, bx1, by0, by1 in rects:
+        c0, c1 = int(np.floor((bx0 - gx) / cw)), int(np.ceil((bx1 - gx) / cw))
+        r0, r1 = int(np.floor((by0 - gy) / ch)), int(np.ceil((by1 - gy) / ch))
+        out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
+    return out
+
+
 def _crop(a: np.ndarray, roi) -> np.ndarray:
     if roi is None:
         return a
