@@ -32,7 +32,7 @@ import numpy as np
 MAX_SIDE = 640  # luma samples along the long side that steps are looked for on (text stays legible)
 K_STEP = 5.0  # a step's pixels changed by this many noise sigmas of a frame difference
 ABS_STEP = 12.0  # and by this many 8-bit codes at least (a noise-free clip has no sigma)
-MIN_PIXELS = 4  # changed samples that make a step
+MIN_PIXELS = 6  # changed samples that make a step
 FROZEN = 0.7  # of them still (text stays text, wall stays wall) in the pair before or after: the overlay
 # is drawn after the camera, without its noise
 REL_FROZEN = 0.1  # still: changed by under this many noise sigmas (and half a code), frame to frame
@@ -44,6 +44,7 @@ STATIC_CONTRAST = 24.0  # 8-bit codes from their neighbourhood's median (a codec
 STATIC_PIXELS = 10  # such samples in a line of text
 FLAT, FLAT_SHARE = 3.0, 0.5  # and this share of them within this many codes of one value: a recorder's
 # text is drawn in one colour, a wall's texture never is
+STEP_FLAT = 4.0  # codes: a step's text side, the same (a codec's ringing about a stroke included)
 MAX_STILL_SHARE = 0.5  # of the frame: where more is as still, stillness tells nothing (a codec's static blocks)
 MAX_FRAME_STEP = 0.03  # of the frame's samples changed at once: more is the whole picture stepping
 MAX_TOTAL = 0.2  # of the frame's area: boxes beyond it are not taken (the check judges the rest)
@@ -73,6 +74,7 @@ class OverlayFilter:
         self._big: deque = deque(maxlen=BEFORE + AFTER + 1)  # (pair index, changed samples) or None
         self._still: deque = deque(maxlen=AFTER + 2)  # (pair index, samples that did not change at all)
         self._prev = None  # the previous frame's sampled luma
+        self._frames: deque = deque(maxlen=AFTER + 2)  # the last frames' sampled luma (a step's either side)
         self._sig: deque = deque(maxlen=HISTORY)
         self._last = None  # the last frame handed on (masked)
         self._index = -1
@@ -90,9 +92,9 @@ class OverlayFilter:
         y = planes.y
         h, w = y.shape
         self._step = max(1, -(-max(h, w) // MAX_SIDE))
-        if self._step > 1:
+        if self._step > 1:  # a lattice, not an average: a text's samples keep its one colour
             y = cv2.resize(y[: h - h % self._step, : w - w % self._step], (w // self._step, h // self._step),
-                           interpolation=cv2.INTER_AREA)
+                           interpolation=cv2.INTER_NEAREST)
         return y.astype(np.float32) / np.float32(1 << (planes.depth - 8))
 
     def _observe(self, planes) -> None:
@@ -100,6 +102,7 @@ class OverlayFilter:
             self._big.append(None)
             return
         s = self._sample(planes)
+        self._frames.append(s)
         prev, self._prev = self._prev, s
         if prev is None or prev.shape != s.shape:
             self._big.append(None)
@@ -145,6 +148,9 @@ class OverlayFilter:
             changed = big[y0:y1, x0:x1]
             still = [m[y0:y1, x0:x1] for i, m in self._still if i in (j - 1, j + 1)]
             if len(still) < 2 or (changed & (still[0] | still[1])).sum() < FROZEN * changed.sum():
+                continue
+            if not _text_step(self._frames[-(AFTER + 2)][y0:y1, x0:x1], self._frames[-(AFTER + 1)][y0:y1, x0:x1],
+                              changed, self._contrast):
                 continue
             found.append((x0, y0, x1, y1))
         return found
@@ -265,6 +271,26 @@ def merged(items) -> list[dict]:
         else:
             groups.append([box, first])
     return [{"box": [int(v) for v in b], "kind": "overlay", "from": f} for b, f in groups]
+
+
+def _text_step(before: np.ndarray, after: np.ndarray, changed: np.ndarray, contrast: float) -> bool:
+    """Whether a step's changed samples are a text's: each one either side of the step is the
+    text's colour (strokes appear or go), so the side farther from the box's median holds one
+    value for most of them, and that value lies beyond the wall's about it (white or black text);
+    a codec's or a shadow's step leaves values the wall has."""
+    b, a = before[changed], after[changed]
+    mb, ma = float(np.median(before)), float(np.median(after))
+    text = np.where(np.abs(a - ma) > np.abs(b - mb), a, b)
+    colour = float(np.median(text))
+    if np.mean(np.abs(text - colour) <= STEP_FLAT) < FLAT_SHARE:
+        return False
+    rest = np.concatenate([before[~changed], after[~changed]])
+    if rest.size < changed.sum():
+        return True  # a box of strokes alone: nothing of the wall to compare with
+    # the wall's spread, robustly (the text's own unchanged strokes are a minority of the box)
+    mid = float(np.median(rest))
+    spread = 2 * 1.4826 * float(np.median(np.abs(rest - mid))) + contrast / 2
+    return bool(abs(colour - mid) > spread)
 
 
 def _arrays(planes) -> list:
