@@ -47,17 +47,19 @@ class InterlaceFilter:
         self._seen: deque = deque(maxlen=5)  # (top field at the bottom rows, bottom field) of the last frames
         self._mean = None  # running means of the ratio and the rate
         self._n = 0
-        self._sums = np.zeros(6)  # sum xy, xx, yy, the samples, zy and zx, over the frames
+        self._sums = np.zeros((2, 6))  # per side: sum xy, xx, yy, the samples, zy and zx, over the frames
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
 
     def _fields(self, y: np.ndarray):
+        """(top field at the bottom rows, bottom field; bottom field at the top rows, top field)."""
         step = max(1, -(-y.shape[1] // MAX_COLUMNS))
         a = np.asarray(y[:, ::step], np.float32)
         top, bottom = a[0::2], a[1::2]
         n = min(top.shape[0] - 1, bottom.shape[0])
-        return np.maximum(0.5 * (top[:n] + top[1:n + 1]), 1.0), bottom[:n]
+        return (np.maximum(0.5 * (top[:n] + top[1:n + 1]), 1.0), bottom[:n],
+                np.maximum(0.5 * (bottom[:n - 1] + bottom[1:n]), 1.0), top[1:n])
 
     def _observe(self, y: np.ndarray, fps: float) -> None:
         if y.shape[0] < 8:
@@ -68,35 +70,41 @@ class InterlaceFilter:
         self._seen.append(cur)
         if len(self._seen) < 5:
             return
-        (far0, _), (before, _), (top, bottom), (after, _), (far1, _) = self._seen
-        ratio = bottom / top - 1.0
-        rate = (after - before) / (2.0 * top)
-        wide = (far1 - far0) / (4.0 * top)  # the rate again, on other frames' noise
         self._n += 1
         a = max(1.0 / (TAU * fps), 1.0 / self._n)
-        if self._mean is None:
-            self._mean = [ratio, rate, wide]
-        else:
-            self._mean = [(1 - a) * m + a * v for m, v in zip(self._mean, (ratio, rate, wide))]
-        if self._n < 3:
-            return
-        yy, xx, zz = ratio - self._mean[0], rate - self._mean[1], wide - self._mean[2]
-        self._sums += (float(np.sum(xx * yy)), float(np.sum(xx * xx)), float(np.sum(yy * yy)), xx.size,
-                       float(np.sum(zz * yy)), float(np.sum(zz * xx)))
+        for side in (0, 1):  # the bottom field against the top, then the top against the bottom
+            far0, before, (ref, other), after, far1 = (f[2 * side] if i != 2 else f[2 * side:2 * side + 2]
+                                                     for i, f in enumerate(self._seen))
+            now = (other / ref - 1.0, (after - before) / (2.0 * ref), (far1 - far0) / (4.0 * ref))
+            mean = self._mean[side] if self._mean is not None else None
+            mean = list(now) if mean is None else [(1 - a) * m + a * v for m, v in zip(mean, now)]
+            self._mean = self._mean or [None, None]
+            self._mean[side] = mean
+            if self._n < 3:
+                continue
+            yy, xx, zz = (v - m for v, m in zip(now, mean))
+            self._sums[side] += (float(np.sum(xx * yy)), float(np.sum(xx * xx)), float(np.sum(yy * yy)), xx.size,
+                                 float(np.sum(zz * yy)), float(np.sum(zz * xx)))
         if self.delta is None and self._n >= MIN_FRAMES and self._n % 4 == 0:
             self._decide()
 
     def _decide(self) -> None:
-        sxy, sxx, syy, n, szy, szx = self._sums
-        if sxx <= 0 or szx <= 0:
-            return
-        slope = sxy / sxx  # the test: no slope unless the fields are two instants
-        se = np.sqrt(max(syy - slope * sxy, 0.0) / n / sxx)
+        # each field read against the other: the offset changes sign, while what the change's
+        # own vertical shape reads into the ratio (a sharp shadow's edge curving the light between
+        # rows, a codec's blocks) does not; half their difference is the offset's alone
+        slopes, ses, ivs = [], [], []
+        for sxy, sxx, syy, n, szy, szx in self._sums:
+            if sxx <= 0 or szx <= 0:
+                return
+            slopes.append(sxy / sxx)
+            ses.append(np.sqrt(max(syy - sxy * sxy / sxx, 0.0) / n / sxx))
+            ivs.append(szy / szx)
+        slope, se = (slopes[0] - slopes[1]) / 2, np.hypot(*ses) / 2
         if slope == 0 or (se > 0 and abs(slope) < T_DECIDE * se):
             return
         # the size: the rate's own noise flattens the slope; measured against the rate read on
         # other frames (whose noise is not the rate's nor the ratio's) it does not
-        delta = szy / szx
+        delta = (ivs[0] - ivs[1]) / 2
         if abs(delta) < MIN_DELTA or np.sign(delta) != np.sign(slope):
             return
         self.delta = min(OFFSETS, key=lambda d: abs(d - delta))
