@@ -28,7 +28,8 @@ from typing import Iterator
 
 import numpy as np
 
-MAX_COLUMNS = 256  # luma columns compared (a lattice on wider frames); every row is read
+MAX_COLUMNS = 128  # luma columns compared (a lattice on wider frames)
+MAX_PAIRS = 192  # groups of four neighbouring rows compared (spread over the frame's height)
 T_DECIDE = 8.0  # t statistic of the slope
 TAU = 1.0  # seconds: the running means' time constant
 MIN_FRAMES = 12
@@ -55,14 +56,15 @@ class InterlaceFilter:
     def _fields(self, y: np.ndarray):
         """(top field at the bottom rows, bottom field; bottom field at the top rows, top field)."""
         step = max(1, -(-y.shape[1] // MAX_COLUMNS))
-        a = np.asarray(y[:, ::step], np.float32)
-        top, bottom = a[0::2], a[1::2]
-        n = min(top.shape[0] - 1, bottom.shape[0])
-        return (np.maximum(0.5 * (top[:n] + top[1:n + 1]), 1.0), bottom[:n],
-                np.maximum(0.5 * (bottom[:n - 1] + bottom[1:n]), 1.0), top[1:n])
+        a = y[:, ::step]
+        n = min((a.shape[0] - 1) // 2, a.shape[0] // 2 - 1)
+        i = np.arange(0, n, max(1, -(-n // MAX_PAIRS)))  # groups of rows 2i..2i+3 (every row of them read)
+        top, bottom = a[2 * i].astype(np.float32), a[2 * i + 1].astype(np.float32)
+        top1, bottom1 = a[2 * i + 2].astype(np.float32), a[2 * i + 3].astype(np.float32)
+        return np.maximum(0.5 * (top + top1), 1.0), bottom, np.maximum(0.5 * (bottom + bottom1), 1.0), top1
 
     def _observe(self, y: np.ndarray, fps: float) -> None:
-        if y.shape[0] < 8:
+        if y.shape[0] < 8 or self.delta is not None:  # decided: nothing more to read
             return
         cur = self._fields(y)
         if self._seen and cur[0].shape != self._seen[-1][0].shape:

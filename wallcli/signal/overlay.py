@@ -81,6 +81,7 @@ class OverlayFilter:
         self._step = 1
         self._taken = None  # samples under a box (their steps are masked already)
         self._run = None  # per sample: frame pairs in a row it has not changed at all
+        self._contrast = ABS_STEP  # codes: what a step changes (K_STEP noise sigmas, ABS_STEP at least)
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
@@ -95,7 +96,9 @@ class OverlayFilter:
         if self._step > 1:  # a lattice, not an average: a text's samples keep its one colour
             y = cv2.resize(y[: h - h % self._step, : w - w % self._step], (w // self._step, h // self._step),
                            interpolation=cv2.INTER_NEAREST)
-        return y.astype(np.float32) / np.float32(1 << (planes.depth - 8))
+        if y.dtype == np.uint8:  # 8-bit: compared as it is (OpenCV's saturating integer ops)
+            return y
+        return (y.astype(np.float32) / np.float32(1 << (planes.depth - 8))).astype(np.float32)
 
     def _observe(self, planes) -> None:
         if min(planes.y.shape) < 16:  # a frame too thin for a line of text (4000x16, 1x1000)
@@ -107,17 +110,24 @@ class OverlayFilter:
         if prev is None or prev.shape != s.shape:
             self._big.append(None)
             return
-        d = np.abs(s - prev)
+        import cv2
+
+        d = cv2.absdiff(s, prev)
         # the noise of a difference: a codec zeroes most differences of a still wall, and the
         # median alone then reads its noise as a fraction of what the rest of the pixels show
-        self._sig.append(max(1.4826 * float(np.median(d)), float(np.percentile(d, 90)) / 1.645))
+        # (read on a lattice: a sixteenth of the samples tell the noise as well)
+        few = d[::4, ::4].astype(np.float32)
+        self._sig.append(max(1.4826 * float(np.median(few)), float(np.percentile(few, 90)) / 1.645))
         sigma = float(np.median(self._sig))
-        big = d > max(K_STEP * sigma, ABS_STEP)
+        self._contrast = max(K_STEP * sigma, ABS_STEP)
+        big = d > self._contrast
         still = d <= max(REL_FROZEN * sigma, 0.5)
         self._still.append((self._index, still))
-        self._run = np.where(still, (0 if self._run is None or self._run.shape != still.shape else self._run) + 1,
-                             0).astype(np.int32)
-        self._contrast = max(K_STEP * sigma, ABS_STEP)
+        if self._run is None or self._run.shape != still.shape:
+            self._run = np.zeros(still.shape, np.uint16)
+        np.minimum(self._run, 60000, out=self._run)
+        self._run += 1
+        self._run *= still
         if self._taken is not None and self._taken.shape == big.shape:
             big &= ~self._taken
         self._big.append((self._index, big if big.any() else None))
@@ -149,8 +159,8 @@ class OverlayFilter:
             still = [m[y0:y1, x0:x1] for i, m in self._still if i in (j - 1, j + 1)]
             if len(still) < 2 or (changed & (still[0] | still[1])).sum() < FROZEN * changed.sum():
                 continue
-            if not _text_step(self._frames[-(AFTER + 2)][y0:y1, x0:x1], self._frames[-(AFTER + 1)][y0:y1, x0:x1],
-                              changed, self._contrast):
+            if not _text_step(self._frames[-(AFTER + 2)][y0:y1, x0:x1].astype(np.float32),
+                              self._frames[-(AFTER + 1)][y0:y1, x0:x1].astype(np.float32), changed, self._contrast):
                 continue
             found.append((x0, y0, x1, y1))
         return found
@@ -163,7 +173,7 @@ class OverlayFilter:
         long = self._run >= max(int(STILL_RUN * fps), 4)
         if not long.any() or long.mean() > MAX_STILL_SHARE:
             return []
-        s = self._prev
+        s = self._prev.astype(np.float32)
         stands_out = np.abs(s - cv2.medianBlur(s, 5)) > max(self._contrast, STATIC_CONTRAST)
         cand = long & stands_out
         if self._taken is not None and self._taken.shape == cand.shape:
@@ -235,7 +245,7 @@ class OverlayFilter:
             j = self._index - AFTER
             if j >= 1 and self._last is not None:
                 boxes = self._judge(j)
-                if self._run is not None and self._index % 4 == 0:
+                if self._run is not None and self._index % 8 == 0:
                     boxes += self._static()
                 if boxes:
                     self._take(boxes, self._waiting[0].time)
