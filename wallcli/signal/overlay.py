@@ -9,8 +9,8 @@ pairs before it nor for ``AFTER`` pairs after it. A text that moves, or any obje
 box in the frames next to the step and is never taken for one.
 
 Text that never changes (a camera name, the clock's date) is found by the same freezing: samples
-that have not changed at all for ``STILL_RUN`` seconds, where the wall's own noise keeps most of
-the frame changing, that stand out from their neighbourhood as a text's strokes do, and most of
+that have hardly changed over ``STILL_RUN`` seconds (a codec touches them now and then), where the
+wall's own noise keeps most of the frame changing, that stand out from their neighbourhood as a text's strokes do, and most of
 which hold one code value (the text's colour).
 
 A box found is filled, from the frame before its first step on, with what that frame showed there,
@@ -39,9 +39,11 @@ REL_FROZEN = 0.1  # still: changed by under this many noise sigmas (and half a c
 BEFORE, AFTER = 3, 2  # frame pairs either side of a step in which its box must not change at all
 PAD = 2  # samples: a step's box widened by this before the pairs either side are read
 MAX_BOX = 0.08  # of the frame's area: an overlay's step (some digits), or a line of text, is no larger
-STILL_RUN = 0.5  # seconds a static text's samples have not changed at all
+STILL_RUN = 0.5  # seconds over which a static text's samples have hardly changed
+STILL_REL = 0.2  # hardly: by under this share of the frame's typical change (and 0.05 codes: not at all)
 STATIC_CONTRAST = 24.0  # 8-bit codes from their neighbourhood's median (a codec leaves wall texture still too)
 STATIC_PIXELS = 10  # such samples in a line of text
+TEXT_LINE = 1 / 12  # of the frame's height: the tallest line of text looked for
 FLAT, FLAT_SHARE = 3.0, 0.5  # and this share of them within this many codes of one value: a recorder's
 # text is drawn in one colour, a wall's texture never is
 STEP_FLAT = 4.0  # codes: a step's text side, the same (a codec's ringing about a stroke included)
@@ -80,7 +82,8 @@ class OverlayFilter:
         self._index = -1
         self._step = 1
         self._taken = None  # samples under a box (their steps are masked already)
-        self._run = None  # per sample: frame pairs in a row it has not changed at all
+        self._run = None  # per sample: its running mean frame-to-frame change (codes)
+        self._run_n = 0
         self._contrast = ABS_STEP  # codes: what a step changes (K_STEP noise sigmas, ABS_STEP at least)
 
     def __getattr__(self, name: str):
@@ -123,11 +126,15 @@ class OverlayFilter:
         big = d > self._contrast
         still = d <= max(REL_FROZEN * sigma, 0.5)
         self._still.append((self._index, still))
-        if self._run is None or self._run.shape != still.shape:
-            self._run = np.zeros(still.shape, np.uint16)
-        np.minimum(self._run, 60000, out=self._run)
-        self._run += 1
-        self._run *= still
+        # how much each sample changes, frame to frame, over the last STILL_RUN seconds (a running
+        # mean): a codec touches a still text by a code now and then, the wall's noise always
+        if self._run is None or self._run.shape != d.shape:
+            self._run, self._run_n = np.zeros(d.shape, np.float32), 0
+        self._run_n += 1
+        fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
+        a = np.float32(max(1.0 / (STILL_RUN * fps), 1.0 / self._run_n))
+        self._run *= 1 - a
+        self._run += a * d
         if self._taken is not None and self._taken.shape == big.shape:
             big &= ~self._taken
         self._big.append((self._index, big if big.any() else None))
@@ -166,15 +173,22 @@ class OverlayFilter:
         return found
 
     def _static(self) -> list[tuple[int, int, int, int]]:
-        """Boxes (sample coordinates) of text that has not changed for STILL_RUN seconds."""
+        """Boxes (sample coordinates) of text that has hardly changed over STILL_RUN seconds."""
         import cv2
 
-        fps = float(getattr(self.reader.info, "fps", 0) or 30.0)
-        long = self._run >= max(int(STILL_RUN * fps), 4)
+        fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
+        if self._run_n < max(STILL_RUN * fps, 4):
+            return []
+        typical = float(np.median(self._run[::4, ::4]))
+        long = self._run <= max(STILL_REL * typical, 0.05)
         if not long.any() or long.mean() > MAX_STILL_SHARE:
             return []
         s = self._prev.astype(np.float32)
-        stands_out = np.abs(s - cv2.medianBlur(s, 5)) > max(self._contrast, STATIC_CONTRAST)
+        # against the wall about it: a neighbourhood twice a line of text's height (a bold
+        # stroke is its own median in a small one)
+        k = max(5, (2 * s.shape[0] * TEXT_LINE) // 2 * 2 + 1)
+        ground = cv2.medianBlur(np.clip(s, 0, 255).astype(np.uint8), int(k)).astype(np.float32)
+        stands_out = np.abs(s - ground) > max(self._contrast, STATIC_CONTRAST)
         cand = long & stands_out
         if self._taken is not None and self._taken.shape == cand.shape:
             cand &= ~self._taken

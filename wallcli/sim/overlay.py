@@ -31,11 +31,12 @@ def text_mask(height: int, width: int, t: float, *, name: str | None = None, sta
     scale = max(FONT_HEIGHT * height / 15.0, 0.5)  # the plain font is 15 px tall at scale 1
     canvas = np.zeros((height, width), np.uint8)
     margin = max(2, height // 36)
-    (_, th), _ = cv2.getTextSize("0", font, scale, 1)
-    cv2.putText(canvas, clock_text(t, width, start), (margin, margin + th), font, scale, 255, 1, cv2.LINE_8)
+    thick = max(1, int(scale / 2))  # strokes as a recorder draws them, bolder on large frames
+    (_, th), _ = cv2.getTextSize("0", font, scale, thick)
+    cv2.putText(canvas, clock_text(t, width, start), (margin, margin + th), font, scale, 255, thick, cv2.LINE_8)
     if name:
-        (nw, _), base = cv2.getTextSize(name, font, scale, 1)
-        cv2.putText(canvas, name, (width - margin - nw, height - margin - base), font, scale, 255, 1, cv2.LINE_8)
+        (nw, _), base = cv2.getTextSize(name, font, scale, thick)
+        cv2.putText(canvas, name, (width - margin - nw, height - margin - base), font, scale, 255, thick, cv2.LINE_8)
     return canvas > 0
 
 
