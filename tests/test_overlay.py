@@ -117,3 +117,21 @@ def test_masked_box_follows_the_light_about_it():
     inside = [float(o.planes.y[y:y + h, x:x + w].mean()) for o in out[60:]]
     # over the last second the light rose 6 %: the box rose with it (a frozen patch: 0 %)
     assert 0.04 < inside[-1] / inside[0] - 1 < 0.08
+
+
+def test_date_and_time_through_h264_are_masked_whole(tmp_path, run_cli):
+    """A wider frame (the date too) through H.264: the codec touches the static text now and
+    then, and bold strokes are their own small neighbourhood; before, only the seconds were
+    masked and the rest of the line read as a moving object when the light moved."""
+    from wallcli.cli.app import main
+
+    clip = tmp_path / "wide.mp4"
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "-o", str(clip), "--people", "1", "--seed", "7", "--size", "640x480", "--duration", "9",
+              "--overlay", "--camera-name", "CAM 01"])
+    assert exc.value.code in (0, None)
+    got = _count(run_cli, clip)
+    assert got["view"]["usable"], got["view"]["reason"]
+    top = [m["box"] for m in got["view"]["masked"] if m["box"][1] < 40]
+    # the line of text runs from x = 12 to about 450: masked along most of it
+    assert sum(w for _, _, w, _ in top) > 300

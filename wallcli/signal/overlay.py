@@ -84,6 +84,7 @@ class OverlayFilter:
         self._taken = None  # samples under a box (their steps are masked already)
         self._run = None  # per sample: its running mean frame-to-frame change (codes)
         self._run_n = 0
+        self._calm = None  # per sample: frame pairs since it last changed by a step's size
         self._contrast = ABS_STEP  # codes: what a step changes (K_STEP noise sigmas, ABS_STEP at least)
 
     def __getattr__(self, name: str):
@@ -130,7 +131,12 @@ class OverlayFilter:
         # mean): a codec touches a still text by a code now and then, the wall's noise always
         if self._run is None or self._run.shape != d.shape:
             self._run, self._run_n = np.zeros(d.shape, np.float32), 0
+            self._calm = np.zeros(d.shape, np.uint16)
         self._run_n += 1
+        # and frames since it last stepped: a moving text's strokes step every few frames
+        np.minimum(self._calm, 60000, out=self._calm)
+        self._calm += 1
+        self._calm[big] = 0
         fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
         a = np.float32(max(1.0 / (STILL_RUN * fps), 1.0 / self._run_n))
         self._run *= 1 - a
@@ -177,10 +183,10 @@ class OverlayFilter:
         import cv2
 
         fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
-        if self._run_n < max(STILL_RUN * fps, 4):
+        if self._run_n < max(2 * STILL_RUN * fps, 4):
             return []
         typical = float(np.median(self._run[::4, ::4]))
-        long = self._run <= max(STILL_REL * typical, 0.05)
+        long = (self._run <= max(STILL_REL * typical, 0.05)) & (self._calm >= 2 * STILL_RUN * fps)
         if not long.any() or long.mean() > MAX_STILL_SHARE:
             return []
         s = self._prev.astype(np.float32)
