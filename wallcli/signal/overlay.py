@@ -4,16 +4,19 @@ A recorder draws its clock after the camera: the text's pixels hold one code val
 change in steps (once a second), all at once and for one frame; a mover changes the picture over
 many frames in a row, wherever it goes. So a change is an overlay's step when it is large (far over
 the clip's frame-to-frame noise, and over ``ABS_STEP`` codes), compact (a line of text, not a
-sizeable part of the frame) and alone in time: nothing changed within its box for ``BEFORE`` frame
-pairs before it nor for ``AFTER`` pairs after it. A text that moves, or any object, changes its
-box in the frames next to the step and is never taken for one.
+sizeable part of the frame, and not the whole frame stepping at once: a cut, a flash), alone in
+time (nothing changed within its box for ``BEFORE`` frame pairs before it nor for ``AFTER`` pairs
+after it), frozen on one side, and a text's (its changed samples hold one value on one side of
+the step, beyond the wall's spread: a codec's keyframe or a shadow stepping in one frame leaves
+values the wall has). A text that moves, or any object, changes its box in the frames next to
+the step and is never taken for one.
 
 Text that never changes (a camera name, the clock's date) is found by the same freezing: samples
 that have hardly changed over ``STILL_RUN`` seconds (a codec touches them now and then), where the
 wall's own noise keeps most of the frame changing, that stand out from their neighbourhood as a text's strokes do, and most of
 which hold one code value (the text's colour).
 
-A box found is filled, from the frame before its first step on, with what that frame showed there,
+A box found is filled, from the frame before it was found on, with what that frame showed there,
 scaled by how the wall's light around the box has changed since: no analysis (the view check,
 the plots, the SNR, the ROI) ever sees the step, while the box follows the light of the wall about
 it. The filled planes are float32 (the fill is a gain, never rounded). Frames wait ``AFTER``
