@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 FONT_HEIGHT = 1 / 12  # of the frame's height: a CCTV clock's line of text (9 px on a 96x72 frame)
-EPOCH = 1_795_708_800  # the clock's reading at t = 0 (2026-11-26 00:00:00 UTC), plus the seed's hour
+EPOCH = 1_795_708_800  # the clock's reading at t = 0 (2026-11-26 16:00:00 UTC)
 
 
 def clock_text(t: float, width: int, start: int = EPOCH) -> str:
