@@ -44,7 +44,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
     from wallcli.signal.corrections import Options
-    from wallcli.signal.repeats import RepeatFilter
+    from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.snr import SnrAccumulator, snr_report
     from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
@@ -71,8 +71,9 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
             if on_frame is not None:
                 on_frame()
 
-        # repeats (a DVR's padding) are missing samples for every analysis of this decode
-        unique = RepeatFilter(reader)
+        # repeats (a DVR's padding) are missing samples, interlaced fields one instant and overlays
+        # masked for every analysis of this decode
+        unique = CameraPipeline(reader, check)
         tee = _Tee(unique, each)
         classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections, native_fps=float(info.fps))
                        for m in used]
@@ -95,9 +96,9 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
     for task in TASKS:
-        if task in out and unique.correction():
-            out[task]["corrections"].append(unique.correction())
-    if "snr" in out and unique.correction():  # as wallcli snr: the file's frames
+        if task in out:
+            out[task]["corrections"] += unique.corrections()
+    if "snr" in out and unique.repeats.correction():  # as wallcli snr: the file's frames
         out["snr"]["frames"] = unique.decoded
     out["corrections"] = next((out[t]["corrections"] for t in TASKS if t in out), [])
     return out

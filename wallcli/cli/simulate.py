@@ -101,6 +101,13 @@ def simulate(
     awb_drift: Optional[float] = number_option(None, "--awb-drift", lo=0, hi=0.2, help="Auto white balance hunting: slow "
                                                "per-colour gains, each wandering its own way by up to this relative "
                                                "amplitude (e.g. 0.01)."),
+    overlay: bool = typer.Option(False, "--overlay", help="Burn in a CCTV clock (HH:MM:SS, with the date on frames 240 "
+                                 "px wide or more) at the top left, white and flat, changing every second."),
+    camera_name: Optional[str] = typer.Option(None, "--camera-name", help="With --overlay: also burn in this fixed "
+                                              "text at the bottom right (e.g. 'CAM 01')."),
+    interlace: Optional[str] = typer.Option(None, "--interlace", help="tff | bff: render at twice --fps and weave "
+                                            "the frames two by two into interlaced ones, the top (tff) or the "
+                                            "bottom (bff) field first, half a frame apart."),
     nuisances: float = number_option(0.0, "--nuisances", lo=0, hi=1, help="Probability that random drift/flicker/AE steps/shake "
                                     "are switched on (explicit options above always apply)."),
     preview: Optional[Path] = typer.Option(None, "--preview", help="Also draw the room from above with the paths beside the "
@@ -156,8 +163,8 @@ def simulate(
             raise UsageError("flatland has no activities: use --world flatland only with --task count")
         if crf is not None:  # each scene's camera draws its own codec and quality from --domain
             raise UsageError("--crf applies to one video; a --dataset's scenes draw their compression from --domain")
-        if dup_frames or tnr or awb_drift:
-            raise UsageError("--dup-frames, --tnr and --awb-drift apply to one video, not to a --dataset")
+        if dup_frames or tnr or awb_drift or overlay or interlace:
+            raise UsageError("--dup-frames, --tnr, --awb-drift, --overlay and --interlace apply to one video, not to a --dataset")
         return _dataset(output, dataset, task, seed, jobs, domain, world, windows_per_scene, shard_scenes, grid_rc, force,
                         json_out, placement, spp, draws)
     if world == "mixed":
@@ -185,13 +192,17 @@ def simulate(
         raise UsageError("--distance MIN must be at least 0.3 m (bodies must stay in front of the wall)")
     if mains is not None and mains not in (50.0, 60.0):
         raise UsageError("--mains must be 50 or 60")
+    if interlace is not None and interlace not in ("tff", "bff"):
+        raise UsageError(f"--interlace must be tff or bff (got {interlace!r})")
+    if camera_name is not None and not overlay:
+        raise UsageError("--camera-name is text of the --overlay; give --overlay too")
     _video(**locals())
 
 
 def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, world, domain, dist, spd, level, iso_gain,
            read_noise, sensor_pixels, prnu, gamma, noise_scale, drift, flicker, mains, ae_steps, shake, nuisances,
            preview, json_out, force, acts, suffix, spp, rolling_shutter=None, dup_frames=None, tnr=None, awb_drift=None,
-           **_):
+           overlay=False, camera_name=None, interlace=None, **_):
     import json
 
     import numpy as np
@@ -213,12 +224,15 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
 
         from wallcli.sim.world_flat import sample_flat_scene
 
-        scene = sample_flat_scene(seed, None, int(people), duration=duration, domain=domain, fps=fps, nuisance_p=nuisances)
+        scene = sample_flat_scene(seed, None, int(people), duration=duration, domain=domain, fps=fps * (2 if interlace else 1),
+                                  nuisance_p=nuisances)
         scene.camera = replace(scene.camera, width=w, height=h, codec=codec, crf=crf, noise_scale=noise_scale, **overrides)
     else:
         from wallcli.sim.scene import SceneConfig, sample_scene
 
-        cfg = SceneConfig(people=people, activities=None if acts == ["random"] else acts, duration=duration, fps=fps,
+        # interlaced: rendered at the field rate, two instants woven into each frame (sim/overlay.py)
+        cfg = SceneConfig(people=people, activities=None if acts == ["random"] else acts, duration=duration,
+                          fps=fps * (2 if interlace else 1),
                           width=w, height=h, grid=grid_rc, domain=domain, distance=dist, speed=spd, codec=codec, crf=crf,
                           noise_scale=noise_scale, nuisance_p=nuisances, camera_overrides=overrides,
                           world="pt" if world == "pt" else "room", spp=spp)
@@ -227,8 +241,9 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
 
             require()  # a missing extra is one clear error before any output is opened
         scene = sample_scene(seed, cfg)
-    n = len(scene.times)
+    n = len(scene.times) // (2 if interlace else 1)
     from wallcli.sim.dvr import dup_mask, pad_frames
+    from wallcli.sim.overlay import interlaced, stamp_rgb
 
     # its own stream of the seed: the same seed with and without --dup-frames renders the same frames
     copies = dup_mask(n, float(dup_frames or 0.0), np.random.default_rng([seed, 0xD0B]))
@@ -240,13 +255,20 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         with VideoWriter(tmp_video, fps, w, h, codec=None if codec == "rawvideo" else codec, crf=crf,
                          pix_fmt=pix_fmt, repeatable=True) as vw:
             with progress("simulate", n) as advance:
-                for frame in pad_frames(scene.frames(), copies):
-                    vw.write(frame)
+                frames = interlaced(scene.frames(), interlace) if interlace else scene.frames()
+                for i, frame in enumerate(pad_frames(frames, copies)):
+                    vw.write(stamp_rgb(frame, i / fps, name=camera_name) if overlay else frame)
                     advance(1)
         truth = scene.truth()
         truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
         if dup_frames:
             truth.update(dup_frames=float(dup_frames), duplicated=int(copies.sum()))
+        if overlay:
+            truth.update(overlay="clock", camera_name=camera_name)
+        if interlace:  # the truth's per-frame positions are the top fields' (even-numbered renders)
+            for person in truth.get("persons", []):
+                person["positions"] = person["positions"][0::2][:n]
+            truth.update(fps=fps, frames=n, interlace=interlace, field_rate=2 * fps)
         tmp_truth.write_text(json.dumps(truth, indent=None, separators=(",", ":")), encoding="utf-8")
         _finish(output, tmp_video, sidecar, truth, preview, json_out, force)
     from wallcli.cli.output import wrote

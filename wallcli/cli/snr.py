@@ -135,7 +135,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.repeats import RepeatFilter
+    from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.snr import SnrAccumulator, snr_db, snr_report
     from wallcli.signal.snr_map import GridAccumulator
     from wallcli.signal.view import ViewCheck
@@ -155,7 +155,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
             grid = GridAccumulator(full, 16, covariance=True)
             whole = ViewCheck()  # where the view fails (a mover, clipping) is no place for the ROI
             with progress("snr: finding the ROI", reader.info.frame_count) as advance:
-                for frame in RepeatFilter(reader).frames():
+                for frame in CameraPipeline(reader, whole).frames():
                     grid.update(frame.planes)
                     whole(frame)
                     advance()
@@ -181,8 +181,9 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
             grid = GridAccumulator(roi_c, 48)
         feed_grid = grid if (grid is not None and not auto) else None
         check = ViewCheck(roi_c)
-        # a repeated frame (a DVR's padding) is a missing sample: its zero difference is no noise
-        unique = RepeatFilter(reader)
+        # a repeated frame (a DVR's padding) is a missing sample: its zero difference is no noise;
+        # interlaced fields are brought to one instant, overlays masked
+        unique = CameraPipeline(reader, check)
         with progress("snr", reader.info.frame_count) as advance:
             for frame in unique.frames():
                 acc.update(frame.planes)
@@ -194,8 +195,8 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     notes += [str(w.message) for w in caught]
     result = snr_report(acc, source=input, fps=fps, notes=notes,
                         roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))
-    if unique.correction():  # "frames" stays the file's; the entry says how many the estimator left out
-        result["corrections"].append(unique.correction())
+    result["corrections"] += unique.corrections()
+    if unique.repeats.correction():  # "frames" stays the file's; the entry says how many the estimator left out
         result["frames"] = unique.decoded
     result["view"] = check.summary()
     if strict:

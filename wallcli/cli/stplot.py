@@ -62,6 +62,7 @@ def stplot(
     from wallcli.signal.stplot import compute_stplot
 
     from wallcli.io.video import FrameTee
+    from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.view import ViewCheck
 
     check_outputs([output, png], force=force, inputs=[input])
@@ -70,7 +71,8 @@ def stplot(
     check = ViewCheck(roi_t)
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
-            plot = compute_stplot(FrameTee(reader, (check,)), roi=roi_t, bins=bins, mean=mean,
+            # repeats left out, interlaced fields at one instant, overlays masked, as count reads it
+            plot = compute_stplot(FrameTee(CameraPipeline(reader, check), (check,)), roi=roi_t, bins=bins, mean=mean,
                                   mean_seconds=mean_seconds, progress=advance, register=True, view=check)
     narrow = narrow_roi(plot.meta["roi"], plot.bins)
     if narrow:

@@ -292,7 +292,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     """
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
-    from wallcli.signal.repeats import RepeatFilter
+    from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
@@ -305,8 +305,9 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
         for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
-        # repeats (a DVR's padding) are missing samples: no tap, row or time sees them
-        unique = RepeatFilter(reader)
+        # repeats (a DVR's padding) are missing samples: no tap, row or time sees them; nor do they
+        # see an interlaced clip's fields at two instants, nor a burned-in overlay
+        unique = CameraPipeline(reader, check)
         rows = RowStream(FrameTee(unique, (check, blend, *taps)), roi=roi, bins=model.bins, fps=model.fps,
                          progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.light,
                          register=corrections.shake)
@@ -318,8 +319,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)
     result = with_view(classifier.result(str(source), frames=unique.decoded), check)
-    if unique.correction():
-        result["corrections"].append(unique.correction())
+    result["corrections"] += unique.corrections()
     result = bound_result(result, blend.correction())  # a blended noise: signal_db an upper bound
     return result, (_thumb_plot(thumb, rows, model) if thumb is not None else None)
 
@@ -368,7 +368,7 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     """
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import RowStream
-    from wallcli.signal.repeats import RepeatFilter
+    from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
@@ -376,8 +376,8 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     check = ViewCheck(roi)
     blend = TemporalNoise()
     with open_video(source, threads=threads) as reader:
-        # repeats left out as in classify_video (a line lists no corrections of the clip's)
-        unique = RepeatFilter(reader)
+        # cleaned as in classify_video (a line lists no corrections of the clip's)
+        unique = CameraPipeline(reader, check)
         rows = RowStream(FrameTee(unique, (check, blend)), roi=roi, bins=model.bins, fps=model.fps,
                          vertical="vertical" in model.input_names or corrections.light, register=corrections.shake)
         for t, row in rows:

@@ -21,7 +21,7 @@ import numpy as np
 
 from wallcli.signal.view_cut import CutWatch
 from wallcli.signal.view_image import (
-    _block_side, _broad_blur, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
+    _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
 )
 from wallcli.signal.view_light import _chroma, _objects, _relative_texture
 from wallcli.signal.view_limits import (
@@ -29,6 +29,7 @@ from wallcli.signal.view_limits import (
     MATCH_RATE, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES, REL, REL_EDGE,
     SHARP, SIGMA_FLOOR, TEX_TAU,
 )
+from wallcli.signal.overlay import merged
 from wallcli.signal.view_motion import _in_band, _motion_verdict, _shift_fits, _texture_match
 from wallcli.wording import span_text
 
@@ -78,12 +79,17 @@ class ViewCheck:
         self._t_tex = self._t_match = -np.inf
         self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
         self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
+        self.masked: list = []  # (box, first seen): burned-in overlays masked out of the frames (signal/overlay)
 
     def __call__(self, frame) -> None:
         gap = getattr(frame, "gap", 0.0)
         if gap:
             self.gap(frame.time - gap, frame.time)
         self.update(frame.time, frame.planes)
+
+    def mask(self, box, first: float = 0.0) -> None:
+        """The frames fed from now on have ``box`` (x, y, w, h, source pixels) masked: an overlay."""
+        self.masked.append((tuple(int(v) for v in box), round(float(first), 4)))
 
     def gap(self, start: float, end: float) -> None:
         """Frames are missing between ``start`` and ``end`` (the times of the frames either side)."""
@@ -131,7 +137,13 @@ class ViewCheck:
         dark = (blocks < DARK) & ~clipped
         ok = ~(clipped | dark)
         self._note_bad(~ok, full, small.shape)
-        usable = float(ok.mean())
+        # an overlay's box (burned-in text, masked in the frames) is neither wall nor fault: not judged
+        hidden = _box_blocks(self._bad_geometry, ok.shape, [b for b, _ in self.masked]) if self.masked else None
+        if hidden is not None and hidden.any() and not hidden.all():
+            ok, clipped, dark = ok & ~hidden, clipped & ~hidden, dark & ~hidden
+            usable = float(ok.sum()) / float((~hidden).sum())
+        else:
+            usable = float(ok.mean())
         self.min_usable = min(self.min_usable, usable)
         flags = set()
         if usable < MIN_USABLE:
@@ -168,21 +180,10 @@ class ViewCheck:
         overlap a block where the view failed on some checked frame (clipped, too dark, or a
         moving object in it). A whole-frame failure (camera motion, a cut) marks no cell: no
         part of the frame escapes it."""
-        out = np.zeros((rows, cols), bool)
-        if self._bad is None or not self._bad.any():
-            return out
-        x0, y0, side, dh, dw, scale = self._bad_geometry
-        gx, gy, gw, gh = roi
-        cw, ch = gw / cols, gh / rows
-        for i, j in zip(*np.nonzero(self._bad)):
-            # the block's source rectangle, then the cells it overlaps (open intervals: a block
-            # that only touches a cell's edge leaves the cell alone)
-            bx0, bx1 = x0 + (dw + j * side) * scale, x0 + (dw + (j + 1) * side) * scale
-            by0, by1 = y0 + (dh + i * side) * scale, y0 + (dh + (i + 1) * side) * scale
-            c0, c1 = int(np.floor((bx0 - gx) / cw)), int(np.ceil((bx1 - gx) / cw))
-            r0, r1 = int(np.floor((by0 - gy) / ch)), int(np.ceil((by1 - gy) / ch))
-            out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
-        return out
+        rects = [(x, x + w, y, y + h) for (x, y, w, h), _ in self.masked]  # an overlay's box is no wall
+        if self._bad is not None and self._bad.any():
+            rects += _block_rects(self._bad_geometry, np.nonzero(self._bad))
+        return _cells(rects, roi, rows, cols)
 
     def _reset(self, hp, small, blocks, planes, full) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
@@ -374,7 +375,7 @@ class ViewCheck:
         """What :meth:`view` and :meth:`summary` answer from, as JSON (a .npz plot's metadata
         keeps it, so answers read from the plot carry the verdict of the video's check)."""
         return {"spans": {k: [list(s) for s in v] for k, v in self.spans.items()}, "frames": self.frames,
-                "max_shift": self.max_shift, "min_usable": self.min_usable,
+                "max_shift": self.max_shift, "min_usable": self.min_usable, "masked": [[list(b), f] for b, f in self.masked],
                 "noise": float(np.median(self._sig_b)) if self._sig_b else None}
 
     @classmethod
@@ -387,6 +388,8 @@ class ViewCheck:
         check.frames = int(record.get("frames") or 0)
         check.max_shift = float(record.get("max_shift") or 0.0)
         check.min_usable = float(record.get("min_usable", 1.0))
+        for box, first in record.get("masked") or []:
+            check.mask(box, first)
         if record.get("noise") is not None:
             check._sig_b.append(float(record["noise"]))
         return check
@@ -397,7 +400,7 @@ class ViewCheck:
         return {**self.view(), "gaps": [list(s) for s in self.spans["frame gap"]],
                 "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
                 "min_usable_area": round(self.min_usable, 3),
-                "noise": None if noise is None else round(noise, 4)}
+                "noise": None if noise is None else round(noise, 4), "masked": merged(self.masked)}
 
 
 def _spans_text(spans: list) -> str:

@@ -26,6 +26,41 @@ def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return cv2.resize(a, size, interpolation=cv2.INTER_LINEAR if fast else cv2.INTER_AREA)
 
 
+def _box_blocks(geometry, shape: tuple[int, int], boxes) -> np.ndarray:
+    """(rows, cols) bool: the blocks of the grid (ViewCheck._note_bad's ``geometry``) that overlap
+    any of ``boxes`` (x, y, w, h, source pixels)."""
+    out = np.zeros(shape, bool)
+    x0, y0, side, dh, dw, scale = geometry
+    for bx, by, bw, bh in boxes:
+        c0 = int(np.floor(((bx - x0) / scale - dw) / side))
+        c1 = int(np.ceil(((bx + bw - x0) / scale - dw) / side))
+        r0 = int(np.floor(((by - y0) / scale - dh) / side))
+        r1 = int(np.ceil(((by + bh - y0) / scale - dh) / side))
+        out[max(r0, 0):max(r1, 0), max(c0, 0):max(c1, 0)] = True
+    return out
+
+
+def _block_rects(geometry, where) -> list:
+    """(x0, x1, y0, y1) source rectangles of the blocks at ``where`` (rows, cols) of the grid."""
+    x0, y0, side, dh, dw, scale = geometry
+    return [(x0 + (dw + j * side) * scale, x0 + (dw + (j + 1) * side) * scale,
+             y0 + (dh + i * side) * scale, y0 + (dh + (i + 1) * side) * scale) for i, j in zip(*where)]
+
+
+def _cells(rects, roi, rows: int, cols: int) -> np.ndarray:
+    """(rows, cols) bool: the cells of a grid over ``roi`` (x, y, w, h) that ``rects`` (x0, x1,
+    y0, y1, source pixels) overlap (open intervals: a rectangle that only touches a cell's edge
+    leaves the cell alone)."""
+    out = np.zeros((rows, cols), bool)
+    gx, gy, gw, gh = roi
+    cw, ch = gw / cols, gh / rows
+    for bx0, bx1, by0, by1 in rects:
+        c0, c1 = int(np.floor((bx0 - gx) / cw)), int(np.ceil((bx1 - gx) / cw))
+        r0, r1 = int(np.floor((by0 - gy) / ch)), int(np.ceil((by1 - gy) / ch))
+        out[max(r0, 0):max(min(r1, rows), 0), max(c0, 0):max(min(c1, cols), 0)] = True
+    return out
+
+
 def _crop(a: np.ndarray, roi) -> np.ndarray:
     if roi is None:
         return a

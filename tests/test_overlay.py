@@ -1,0 +1,137 @@
+"""Burned-in overlays (a CCTV clock and a camera name, ``simulate --overlay``): found, masked out of
+every analysis and listed in ``view.masked``; the same text moving through the view is an object
+and stays refused."""
+
+from __future__ import annotations
+
+import json
+
+import av
+import numpy as np
+import pytest
+
+from clips import write_clip
+
+SIM = ["--people", "1", "--activity", "walking", "--seed", "5", "--size", "160x120", "--duration", "9.5"]
+
+
+@pytest.fixture(scope="module")
+def stamped(tmp_path_factory):
+    """One walker (seed 5, 160x120, 9.5 s, lossless), clean and with a clock and a camera name;
+    and the clean frames with the clock's text sliding across the view (an object, not an overlay)."""
+    from wallcli.cli.app import main
+    from wallcli.sim.overlay import text_mask
+
+    d = tmp_path_factory.mktemp("overlay")
+    out = {}
+    for name, extra in (("clean", []), ("overlay", ["--overlay", "--camera-name", "CAM 01"])):
+        out[name] = d / f"{name}.mkv"
+        with pytest.raises(SystemExit) as exc:
+            main(["simulate", "-o", str(out[name]), *SIM, *extra])
+        assert exc.value.code in (0, None)
+    with av.open(str(out["clean"])) as c:
+        frames = [f.to_ndarray(format="rgb24") for f in c.decode(video=0)]
+
+    def moving(i):
+        # the clock's text, moved 1 px a frame to the right and down a row every 8 frames
+        f = frames[i].astype(np.float64)
+        m = np.roll(np.roll(text_mask(120, 160, 0.0), i % 100, axis=1), 30 + i // 8 % 40, axis=0)
+        f[m] = 255.0
+        return f
+
+    out["moving"] = write_clip(d / "moving.mkv", moving, len(frames), codec="ffv1", pix_fmt="yuv444p")
+    return out
+
+
+def _count(run_cli, path):
+    code, out, err = run_cli("count", path, "--json")
+    assert code == 0, err
+    return json.loads(out)
+
+
+def test_simulate_draws_the_clock_and_says_so(stamped):
+    truth = json.loads(stamped["overlay"].with_suffix(".json").read_text())
+    assert truth["overlay"] == "clock" and truth["camera_name"] == "CAM 01"
+    with av.open(str(stamped["overlay"])) as c:
+        a, b = [f.to_ndarray(format="rgb24").astype(int) for f, _ in zip(c.decode(video=0), range(31))][29:31]
+    # the clock steps at 1 s (frame 30): only its top-left corner changes, by a text's contrast
+    diff = np.abs(b - a).max(axis=2)
+    assert diff[:20, :60].max() > 40 and diff[20:, :].max() < 40
+
+
+def test_overlay_is_masked_listed_and_the_answer_is_the_clean_one(stamped, run_cli):
+    clean, got = _count(run_cli, stamped["clean"]), _count(run_cli, stamped["overlay"])
+    assert clean["view"]["usable"] and clean["view"]["masked"] == []
+    # before: "moving object" at 1.3-2.1 s and four more spans, the clip refused
+    assert got["view"]["usable"], got["view"]["reason"]
+    boxes = [m["box"] for m in got["view"]["masked"]]
+    assert all(m["kind"] == "overlay" for m in got["view"]["masked"])
+    # the clock at the top left and the name at the bottom right, each in a box no larger than a line of text
+    assert any(x < 10 and y < 10 for x, y, _, _ in boxes)
+    assert any(x + w > 150 and y + h > 110 for x, y, w, h in boxes)
+    assert all(h <= 24 and w <= 80 for _, _, w, h in boxes)
+    assert got["label"] == clean["label"] == 1
+    assert abs(got["signal_db"] - clean["signal_db"]) <= 3.0
+
+
+def test_text_moving_through_the_view_is_still_an_object(stamped, run_cli):
+    got = _count(run_cli, stamped["moving"])
+    assert not got["view"]["usable"]
+    assert "moving object" in got["view"]["issues"]
+    assert got["view"]["masked"] == []
+
+
+def test_snr_auto_roi_leaves_the_overlay_out(stamped, run_cli):
+    code, out, err = run_cli("snr", stamped["overlay"], "--roi", "auto", "--json")
+    assert code == 0, err
+    got = json.loads(out)
+    assert got["view"]["usable"] and got["view"]["masked"]
+    x, y, w, h = got["roi"]
+    for bx, by, bw, bh in (m["box"] for m in got["view"]["masked"]):
+        assert bx >= x + w or bx + bw <= x or by >= y + h or by + bh <= y  # no overlap
+
+
+def test_masked_box_follows_the_light_about_it():
+    """A frame-wide gain ramp (exposure) goes on inside a masked box as outside: the box is no
+    frozen patch that a change of light would make stand out."""
+    from types import SimpleNamespace
+
+    from wallcli.io.planes import Planes
+    from wallcli.io.video import Frame
+    from wallcli.signal.overlay import OverlayFilter
+    from wallcli.sim.overlay import text_mask
+
+    rng = np.random.default_rng(0)
+    wall = 120 + 20 * rng.random((72, 96))
+
+    def frame(i):
+        y = wall * (1 + 0.002 * i) + rng.normal(0, 2, wall.shape)
+        y[text_mask(72, 96, i / 30)] = 235
+        return Frame(i, i / 30, Planes(y.astype(np.float32), None, None, "gray"))
+
+    reader = SimpleNamespace(info=SimpleNamespace(fps=30), frames=lambda: (frame(i) for i in range(90)))
+    f = OverlayFilter(reader)
+    out = list(f.frames())
+    assert len(out) == 90 and f.masked()
+    x, y, w, h = f.masked()[0]["box"]
+    inside = [float(o.planes.y[y:y + h, x:x + w].mean()) for o in out[60:]]
+    # over the last second the light rose 6 %: the box rose with it (a frozen patch: 0 %)
+    assert 0.04 < inside[-1] / inside[0] - 1 < 0.08
+
+
+def test_date_and_time_through_h264_are_masked_whole(tmp_path, run_cli):
+    """A wider frame (the date too) through H.264: the codec touches the static text now and
+    then, and bold strokes are their own small neighbourhood; before, only the seconds were
+    masked and the rest of the line read as a moving object when the light moved."""
+    from wallcli.cli.app import main
+
+    clip = tmp_path / "wide.mp4"
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "-o", str(clip), "--people", "1", "--seed", "7", "--size", "640x480", "--duration", "9",
+              "--overlay", "--camera-name", "CAM 01"])
+    assert exc.value.code in (0, None)
+    got = _count(run_cli, clip)
+    assert got["view"]["usable"], got["view"]["reason"]
+    top = [m["box"] for m in got["view"]["masked"] if m["box"][1] < 40]
+    # the line of text runs from x = 12 to about 450: masked along most of it
+    assert sum(w for _, _, w, _ in top) > 300

@@ -1,0 +1,47 @@
+"""The decode as every analysis reads it: a camera pipeline's artefacts taken out, in one pass.
+
+Repeated frames (a DVR's padding) are left out (:mod:`wallcli.signal.repeats`), burned-in
+overlays masked (:mod:`wallcli.signal.overlay`) and an interlaced clip's fields brought to one
+instant (:mod:`wallcli.signal.interlace`), in that order: a copy is no step of a clock, and a
+recorder's text, which does not follow the wall's light, would read as fields at two instants
+(its fill follows the light as the wall does). Each keeps a few frames at most; memory stays flat.
+"""
+
+from __future__ import annotations
+
+from typing import Iterator
+
+from wallcli.signal.interlace import InterlaceFilter
+from wallcli.signal.overlay import OverlayFilter
+from wallcli.signal.repeats import RepeatFilter
+
+
+class CameraPipeline:
+    """A reader whose :meth:`frames` are the cleaned frames; everything else is the reader's.
+
+    ``check`` (a :class:`wallcli.signal.view.ViewCheck`, or several) is told the overlay boxes
+    masked, for the ``view`` it reports and the ROI it avoids. ``decoded`` counts the file's frames."""
+
+    def __init__(self, reader, check=None) -> None:
+        self.reader = reader
+        self.repeats = RepeatFilter(reader)
+        self.overlay = OverlayFilter(self.repeats, check)
+        self.interlace = InterlaceFilter(self.overlay)
+
+    def __getattr__(self, name: str):
+        return getattr(self.reader, name)
+
+    @property
+    def decoded(self) -> int:
+        return self.repeats.decoded
+
+    @property
+    def last_time(self) -> float:
+        return self.repeats.last_time
+
+    def frames(self) -> Iterator:
+        return self.interlace.frames()
+
+    def corrections(self) -> list[dict]:
+        """The ``corrections`` entries (docs/contract.md) of what was found and taken out."""
+        return [c for c in (self.repeats.correction(), self.interlace.correction()) if c]
