@@ -62,6 +62,10 @@ class _Tee:
 
         self.view = ViewCheck(roi)
         self.blend = TemporalNoise()  # a camera's temporal noise reduction (signal/tnr.py)
+        from wallcli.signal.pipeline import CameraPipeline
+
+        # repeats, burned-in overlays and interlaced fields taken out as for count and activity
+        self.pipeline = CameraPipeline(reader, self.view)
 
     @property
     def warnings(self) -> list[str]:
@@ -73,7 +77,7 @@ class _Tee:
         from wallcli.signal.snr_map import GridAccumulator
 
         self.last = 0.0
-        for frame in self._reader.frames():
+        for frame in self.pipeline.frames():
             self.last = frame.time
             planes = frame.planes
             if self.snr is None:
@@ -200,6 +204,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         try:
             out.results[task] = bound_result(with_view(c.result(str(source), frames=rows.frames), tee.view),
                                              tee.blend.correction())
+            out.results[task]["corrections"] += tee.pipeline.corrections()
         except WallcliError as exc:  # too short for one window: the rest of the report still stands
             out.failures[task] = str(exc)
     return out

@@ -26,7 +26,8 @@ from wallcli.signal.view_image import (
 from wallcli.signal.view_light import _chroma, _objects, _relative_texture
 from wallcli.signal.view_limits import (
     CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
-    MATCH_RATE, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES, REL, REL_EDGE,
+    MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
+    REL, REL_EDGE,
     SHARP, SIGMA_FLOOR, TEX_TAU,
 )
 from wallcli.signal.overlay import merged
@@ -80,6 +81,9 @@ class ViewCheck:
         self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
         self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
         self.masked: list = []  # (box, first seen): burned-in overlays masked out of the frames (signal/overlay)
+        # each 'moving object' flag's time and blocks, until too many to keep: an overlay is only
+        # recognised after its text has stepped a few times, and those steps were flagged first
+        self._object_hits: list | None = []
 
     def __call__(self, frame) -> None:
         gap = getattr(frame, "gap", 0.0)
@@ -88,8 +92,25 @@ class ViewCheck:
         self.update(frame.time, frame.planes)
 
     def mask(self, box, first: float = 0.0) -> None:
-        """The frames fed from now on have ``box`` (x, y, w, h, source pixels) masked: an overlay."""
+        """The frames fed from now on have ``box`` (x, y, w, h, source pixels) masked: an overlay.
+        Earlier 'moving object' flags whose blocks all lie in the overlays' boxes were the text's
+        own steps, before it was recognised: they are taken back."""
+        import cv2
+
         self.masked.append((tuple(int(v) for v in box), round(float(first), 4)))
+        hits = self._object_hits
+        if not hits or self._bad_geometry is None:
+            return
+        shape = hits[0][1].shape
+        hidden = _box_blocks(self._bad_geometry, shape, [b for b, _ in self.masked])
+        near = cv2.dilate(hidden.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        kept = [(t, b) for t, b in hits if b.shape != shape or (b & ~near).any()]
+        if len(kept) == len(hits):
+            return
+        self._object_hits = kept
+        self.spans["moving object"] = []
+        for t, _ in kept:
+            self._mark("moving object", t)
 
     def gap(self, start: float, end: float) -> None:
         """Frames are missing between ``start`` and ``end`` (the times of the frames either side)."""
@@ -318,6 +339,10 @@ class ViewCheck:
         if not moved and int(judged.sum()) >= MIN_MOVER_BLOCKS:
             flags.add("moving object")
             self._bad |= judged
+            if self._object_hits is not None:
+                self._object_hits.append((t, judged.copy()))
+                if len(self._object_hits) > MAX_OBJECT_HITS:  # memory stays flat: no taking back from now on
+                    self._object_hits = None
         # every frame for a while after anything suspect; a sharp change of light is not
         if suspect or moved or judged.any() or ((broad & ok).any() and not outlined):
             self._dense_until = t + DENSE
@@ -388,6 +413,7 @@ class ViewCheck:
         check.frames = int(record.get("frames") or 0)
         check.max_shift = float(record.get("max_shift") or 0.0)
         check.min_usable = float(record.get("min_usable", 1.0))
+        check._object_hits = None  # the spans recorded are final
         for box, first in record.get("masked") or []:
             check.mask(box, first)
         if record.get("noise") is not None:
