@@ -50,15 +50,9 @@ GRID = np.round(np.arange(0.0, 0.96, 0.01), 2)
 
 
 def _tiles(h: int, w: int) -> list[tuple[int, int]]:
-    """Top-left corners of up to MAX_TILES tiles spread over an (h, w) plane (4 px from its edges)."""
-    ny, nx = max((h - 8) // TILE, 0), max((w - 8) // (TILE + 2), 0)
-    if not ny or not nx:
-        return []
-    gy = int(min(ny, max(1, round(np.sqrt(MAX_TILES * ny / nx)))))
-    gx = int(min(nx, max(1, MAX_TILES // gy)))
-    ys = np.linspace(4, h - 4 - TILE, gy).astype(int)
-    xs = np.linspace(4, w - 6 - TILE, gx).astype(int)
-    return [(int(y), int(x)) for y in ys for x in xs]
+    from wallcli.signal.tnr import _tiles as tiles
+
+    return tiles(h, w, TILE, MAX_TILES)
 
 
 class TemporalNoise:

@@ -35,15 +35,16 @@ HELD = 0.001  # share of 8x8 blocks held unchanged from which a codec, not the c
 # (the transfer set: lossless 0, its CRF 10-14 clips 0.006-0.56; sensor noise of 0.35 codes: ~1e-14)
 
 
-def _tiles(h: int, w: int) -> list[tuple[int, int]]:
-    """Top-left corners of up to MAX_TILES tiles spread over an (h, w) plane, 4 px from its edges."""
-    ny, nx = max((h - 8) // TILE, 0), max((w - 10) // TILE, 0)
+def _tiles(h: int, w: int, tile: int = TILE, max_tiles: int = MAX_TILES) -> list[tuple[int, int]]:
+    """Top-left corners of up to ``max_tiles`` tiles of ``tile`` px spread over an (h, w) plane,
+    4 px from its edges."""
+    ny, nx = max((h - 8) // tile, 0), max((w - 10) // tile, 0)
     if not ny or not nx:
         return []
-    gy = int(min(ny, max(1, round(np.sqrt(MAX_TILES * ny / nx)))))
-    gx = int(min(nx, max(1, MAX_TILES // gy)))
-    ys = np.linspace(4, h - 4 - TILE, gy).astype(int)
-    xs = np.linspace(4, w - 6 - TILE, gx).astype(int)
+    gy = int(min(ny, max(1, round(np.sqrt(max_tiles * ny / nx)))))
+    gx = int(min(nx, max(1, max_tiles // gy)))
+    ys = np.linspace(4, h - 4 - tile, gy).astype(int)
+    xs = np.linspace(4, w - 6 - tile, gx).astype(int)
     return [(int(y), int(x)) for y in ys for x in xs]
 
 
