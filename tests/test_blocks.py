@@ -120,3 +120,25 @@ def test_the_projector_converts_to_rgb_as_to_rgb_does(kind):
         vc, vr = projection_means(planes.v, rows / sy, cols / sx)
         want_h, want_v = planes.to_rgb(yc, uc, vc), planes.to_rgb(yr, ur, vr)
     assert np.allclose(h, want_h, rtol=0, atol=1e-4) and np.allclose(v, want_v, rtol=0, atol=1e-4)
+
+
+def test_the_camera_pipeline_holds_one_opencv_thread_for_its_decode_and_gives_it_back(tmp_path):
+    # A toggle per call once OpenCV's pool has worked rebuilds it (0.3-0.7 ms, four a frame):
+    # the pipeline sets one thread for the whole decode, and a library caller's setting is back after.
+    import cv2
+
+    from clips import write_clip
+    from wallcli.io.video import open_video
+    from wallcli.signal.pipeline import CameraPipeline
+
+    rng = np.random.default_rng(5)
+    clip = write_clip(tmp_path / "wall.mp4", lambda i: 120 + rng.normal(0, 2, (72, 96, 3)), 12)
+    before = cv2.getNumThreads()
+    try:
+        cv2.setNumThreads(3)
+        with open_video(clip) as reader:
+            inside = [cv2.getNumThreads() for _ in CameraPipeline(reader).frames()]
+        assert len(inside) == 12 and set(inside) == {1}
+        assert cv2.getNumThreads() == 3
+    finally:
+        cv2.setNumThreads(before)

@@ -198,11 +198,16 @@ def one_opencv_thread():
     short for its pool to pay for its hand-offs, and the decoder thread already keeps every core
     busy. Measured on 1080p H.264, 2 cores: 0.25 ms a frame on one thread against 0.75 on two (2-3
     ms with other work on the cores); `wallcli count` 15 % and `stplot` 22 % less wall time
-    (bench/RESULTS.md, session 10). Restored on leaving (0.4 us a toggle), so a program using
-    wallcli as a library keeps its own OpenCV threading."""
+    (bench/RESULTS.md, session 10). Restored on leaving, so a program using wallcli as a library
+    keeps its own OpenCV threading. A toggle is 0.2 us alone but 0.3-0.7 ms once the pool has
+    worked (it is rebuilt), so :class:`wallcli.signal.pipeline.CameraPipeline` holds one thread
+    for the whole decode and the per-frame calls inside find it set."""
     import cv2
 
     threads = cv2.getNumThreads()
+    if threads == 1:  # already inside one (the camera pipeline holds it for a whole decode)
+        yield
+        return
     cv2.setNumThreads(1)
     try:
         yield
