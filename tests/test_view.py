@@ -70,6 +70,18 @@ def test_what_is_not_a_still_wall_is_refused_and_named(tmp_path, kind, issue):
     assert view["reason"].startswith("not a static view of the wall: ") and " s" in view["reason"]
 
 
+def test_a_large_fast_shake_is_camera_motion(tmp_path):
+    # 3 px rms with a time scale of a few frames: the camera moves several pixels between checks,
+    # so the shifts it holds to agree cannot all lie within a pixel of each other; they agree
+    # within half the shift (1 px before: this clip passed as a still view)
+    from wallcli.sim import views
+
+    rng = np.random.default_rng(21)
+    src = _scene(21, "base", SECONDS, texture=0.04)
+    view = _check(_encode(tmp_path / "s.mp4", views.shake(src, rng, n=N, fps=FPS, rms=3.0)))
+    assert "camera motion" in view["issues"], view
+
+
 def test_clipped_and_dark_frames_leave_too_little_usable_area(tmp_path):
     rng = np.random.default_rng(0)
 

@@ -261,7 +261,9 @@ class ViewCheck:
             suspect |= fits
             fits &= shift >= MIN_SHIFT
             if fits:
-                near = [1 for x, y in self._shifts if np.hypot(dx - x, dy - y) * self._scale < 1.0]
+                # within a pixel, or half the shift: a shake of a few pixels moves that far between
+                # checks (3 px rms shakes passed as still with a 1 px tolerance)
+                near = [1 for x, y in self._shifts if np.hypot(dx - x, dy - y) * self._scale < max(1.0, 0.5 * shift)]
                 moved = len(near) + 1 >= HOLD
             self._shifts.append((dx, dy) if fits else (np.inf, np.inf))
         else:
