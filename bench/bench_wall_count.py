@@ -16,7 +16,6 @@ from landing on one side only. CPU-time ratios are printed too.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
 import subprocess
@@ -24,6 +23,10 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from bench_speed import measure  # noqa: E402  (one job in a fresh process: bench/measure.py)
+
 OUT = HERE / "out"
 
 
@@ -38,13 +41,6 @@ def wall_clip(seconds: int, fps: int = 30) -> Path:
                         str(seconds), "--fps", str(fps), "--crf", "18", "--grid", "32x32", "--force"],
                        check=True, stdout=subprocess.DEVNULL)
     return path
-
-
-def measure(*args: str) -> dict:
-    out = subprocess.run([sys.executable, str(HERE / "measure.py"), *args], capture_output=True, text=True)
-    if out.returncode:
-        raise SystemExit(f"{' '.join(args)} failed:\n{out.stderr}")
-    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def main() -> None:
