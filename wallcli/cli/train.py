@@ -19,8 +19,19 @@ class Task(str, Enum):
 
 def train(
     task: Task = typer.Argument(..., help="Which network: 'count' (0/1/2 people) or 'activity'."),
-    data: List[Path] = typer.Option(..., "--data", help="Dataset folder from the simulator (dataset.json + shards); "
+    data: List[Path] = typer.Option([], "--data", help="Dataset folder from the simulator (dataset.json + shards); "
                                     "repeat it to train on several folders as one dataset."),
+    clips: List[Path] = typer.Option([], "--clips", help="Folder of labelled recordings (any folder 'wallcli evaluate' "
+                                     "reads: labels.csv or .json sidecars); repeatable. Each clip is cut into windows "
+                                     "through the path inference takes (camera pipeline, corrections, both plots) every "
+                                     "16 samples, cached in --clip-cache. With --data as well, both are trained on."),
+    folds: int = number_option(0, "--folds", lo=0, hi=50, integer=True, help="With --clips: first train once per fold "
+                               "(the clip's number in its file name mod K) on the other folds, answer that fold's clips "
+                               "as 'wallcli count/activity' would, print the out-of-fold table and write it in the "
+                               "card ('recordings'); the decided/undetermined thresholds are fitted on those answers. "
+                               "0: no folds. Then the model is trained on every clip."),
+    clip_cache: Optional[Path] = typer.Option(None, "--clip-cache", help="Where the recordings' windows are cached "
+                                              "(default: $WALLCLI_CACHE/recordings or ~/.cache/wallcli/recordings)."),
     out: Path = typer.Option(..., "--out", "-o", help="Model to write (.onnx); its card goes beside it (.json)."),
     val: Optional[Path] = typer.Option(None, "--val", help="Validation dataset folder (default: hold out --val-fraction of --data)."),
     val_fraction: float = number_option(0.1, "--val-fraction", lo=0, hi=0.5, help="Share of --data held out when there is no --val."),
@@ -108,6 +119,12 @@ def train(
     from wallcli.train.export import export_model
     from wallcli.train.loop import ANNEAL_FLOOR, TrainConfig, train as run_training
 
+    if not data and not clips:
+        raise UsageError("nothing to train on: give --data (simulated windows) or --clips (labelled recordings)")
+    if folds == 1:
+        raise UsageError("--folds must be 0 (none) or at least 2")
+    if folds and not clips:
+        raise UsageError("--folds needs --clips: folds split labelled recordings by clip")
     if select not in ("last", "best"):
         raise UsageError(f"--select must be last or best (got {select!r})")
     if quantize not in ("none", "int8"):
@@ -134,7 +151,7 @@ def train(
     if out.suffix.lower() != ".onnx":
         raise UsageError(f"--out must end in .onnx: {out}")
     read = [f for d in [*data, val, *calibrate] if d is not None
-            for f in [Path(d) / "dataset.json", *sorted(Path(d).glob("shard-*.npz"))]] + [init]
+            for f in [Path(d) / "dataset.json", *sorted(Path(d).glob("shard-*.npz"))]] + [init] + [Path(c) / "labels.csv" for c in clips]
     check_outputs([out, card_path(out)], force=force, inputs=read)
     # the checkpoint is read and rewritten by every run of this training (no --force needed), but
     # it must not be one of the data's files, or the model's
@@ -161,6 +178,13 @@ def train(
 
     # `kill PID` of a background run saves a checkpoint like Ctrl-C (then exits 1): wallcli.cli._signals,
     # installed by main(), turns both into wallcli.errors.Interrupted, which run_training catches.
+    recordings = None
+    if clips:
+        from wallcli.cli._train_clips import prepare
+
+        cfg, recordings = prepare(cfg, task.value, list(clips), list(data), folds, clip_cache, out,
+                                  lambda: _TrainProgress(console_err), confidence_level)
+
     with _TrainProgress(console_err) as bar:
         result = run_training(cfg, bar.event)
 
@@ -180,7 +204,7 @@ def train(
     fields = dict(
         name=name or f"wallcli-{task.value}", version=model_version, task=task.value, classes=ds.classes, stride=stride,
         preprocessing=prep, normalisation=NORMALIZATION_TEXT[prep],
-        training_data={"dataset": [str(d) for d in data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
+        training_data={"dataset": [str(d) for d in cfg.data], "recipe": ds.recipes, "seed": [m.get("seed") for m in ds.manifests],
                        "windows": ds.n, "train_windows": result["train_windows"], "min_snr_db": min_snr_db,
                        "windows_seen": _windows_seen(ds.manifests, base)},
         training={**({"init": init_info} if init_info else {}), "arch": arch, "seed": seed, "epochs": epochs, "batch_size": batch_size, "optimizer": "RMSprop", "lr": cfg.lr,
@@ -192,7 +216,8 @@ def train(
                   "selected_epoch": result["best_epoch"], "history": result["history"],
                   "command": f"wallcli train {task.value} " + " ".join(f"--data {d}" for d in data)
                              + f" --out {out} --epochs {epochs} --batch-size {batch_size} --seed {seed} --ema {ema:g} --select {select}"
-                             + (f" --val {val}" if val else f" --val-fraction {val_fraction}")
+                             + "".join(f" --clips {c}" for c in clips) + (f" --folds {folds}" if folds else "")
+                             + (f" --val {val}" if val else f" --val-fraction {cfg.val_fraction}")
                              + ("" if augment else " --no-augment")
                              + (f" --superpose {superpose:g}" if superpose > 0 else "")
                              + (f" --min-snr-db {min_snr_db:g}" if min_snr_db is not None else "")
@@ -210,6 +235,10 @@ def train(
     quant = _calibration(result, seed, prep) if quantize == "int8" else None
     card = export_model(result["net"], ds.inputs, out, fields, force=force, seed=seed, quantize=quant,
                         evaluation=_evaluation(result, prep))
+    if recordings is not None:
+        from wallcli.cli._train_clips import write_block
+
+        card = write_block(out, recordings)
     if calibrate:
         from wallcli.train.calibrate import calibrate as fit_confidence
 

@@ -1,0 +1,85 @@
+"""``wallcli train --clips DIR [--folds K]``: the recordings' windows, the out-of-fold table, the card's block."""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+def default_cache() -> Path:
+    base = os.environ.get("WALLCLI_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "wallcli")
+    return Path(base) / "recordings"
+
+
+def prepare(cfg, task: str, clips: list[Path], sim_data: list[Path], folds: int, cache: Path | None, out: Path,
+            bars, level: float) -> tuple[Any, dict[str, Any]]:
+    """(the final run's config: every recording plus ``sim_data``, the card's ``recordings`` block)."""
+    from wallcli.cli.output import log, progress
+    from wallcli.infer.twostage import load_classifier
+    from wallcli.train import folds as fl
+    from wallcli.train.recordings import FOLD_RULE, HARVEST_STRIDE, count_clips, load_recordings
+
+    with progress("cutting recordings into windows", count_clips(clips, task)) as advance:
+        recs = load_recordings(clips, cache or default_cache(), task=task, progress=lambda name: advance(1))
+    work = out.parent / f".{out.name}.recordings"  # fold datasets, fold models and their answers: resumable
+    fold_dirs = fl.write_fold_datasets(recs, task, work / "data", folds)
+    windows = sum(len(r.starts) for r in recs)
+    block: dict[str, Any] = {"clips": len(recs), "windows": windows, "stride": HARVEST_STRIDE,
+                             "folders": [str(c) for c in clips], "folds": folds}
+    log(f"{len(recs)} labelled clips, {windows} windows (every {HARVEST_STRIDE} samples at 30 fps)")
+    if folds:
+        answers = fl.cross_validate(cfg, fold_dirs, sim_data, recs, work, bars=bars, log=log,
+                                    load=lambda p: load_classifier(task, p))
+        classes = [0, 1, 2] if task == "count" else ["none", "walking", "crouching", "waving", "jumping"]
+        table, trust = judge_out_of_fold(recs, answers, task, classes, level, folds)
+        block.update(fold_rule=FOLD_RULE, out_of_fold=table, confidence=trust)
+        for line in [f"out of fold ({folds} folds, each answered by a model that never saw it):",
+                     *fl.format_table(table, task)]:
+            log(line)
+    final = replace(cfg, data=list(fold_dirs) + list(sim_data),
+                    val_fraction=0.0 if cfg.val is None else cfg.val_fraction)
+    return final, block
+
+
+def judge_out_of_fold(recs, answers, task, classes, level, k) -> tuple[dict, dict]:
+    """The out-of-fold table, whose decided answers are judged by thresholds fitted on the other
+    folds' answers only, and the thresholds fitted on every fold's (what the card ships)."""
+    from wallcli.infer.confidence import judge
+    from wallcli.train import folds as fl
+    from wallcli.train.recordings import fold_of
+
+    names = [r.name for r in recs]
+    probs = np.array([answers[n]["probs"] for n in names])
+    labels = np.array([classes.index(fl.truth(r, task)) for r in recs])
+    sig = np.array([answers[n]["signal_db"] for n in names])
+    fold = np.array([fold_of(n, k) for n in names])
+    graded = {}
+    for f in range(k):
+        o = fold != f
+        block = fl.fit_trust(probs[o], labels[o], sig[o], classes, level=level)
+        for i in np.flatnonzero(fold == f):
+            graded[names[i]] = {"label": classes[int(np.argmax(probs[i]))],
+                                "confident": judge(block, probs[i], float(sig[i]), classes)[0]}
+    table = fl.oof_table(recs, graded, task, classes)
+    table["decided_by"] = ("thresholds fitted on the other folds' out-of-fold answers (each fold's decisions are "
+                           "judged on answers their thresholds never saw)")
+    return table, fl.fit_trust(probs, labels, sig, classes, level=level)
+
+
+def write_block(out: Path, block: dict[str, Any]) -> dict[str, Any]:
+    """The card of ``out`` with ``recordings`` and, from its folds, the ``confidence`` thresholds."""
+    from wallcli.infer.card import card_path, read_card
+    from wallcli.io.writer import write_text_atomic
+
+    card = read_card(out)
+    block = dict(block)
+    trust = block.pop("confidence", None)
+    card["recordings"] = block
+    if trust is not None:
+        card["confidence"] = trust
+    write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=True)
+    return read_card(out)

@@ -1,0 +1,219 @@
+"""Training on labelled recordings, and the out-of-fold figures that choose between models.
+
+The recordings' windows (:mod:`wallcli.train.recordings`) are written as one shard dataset per
+fold, in the simulator's format, so the one training loop reads recordings, simulated windows, or
+both. ``--folds K``: for each fold, a net trained on the other folds answers that fold's clips,
+exactly as ``wallcli count``/``activity`` answer a clip (the card's stride, the windows' mean);
+all folds together are the candidate's figure. No window of a clip is ever in two folds.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wallcli.errors import WallcliError
+from wallcli.train.recordings import BINS, WINDOW, Recording, fold_of
+
+BANDS = (("empty", None, None), ("<0 dB", None, 0.0), ("0-10 dB", 0.0, 10.0), (">=10 dB", 10.0, None))
+Z95_ONE_SIDED = 1.6449
+
+
+def truth(rec: Recording, task: str) -> Any:
+    return rec.people if task == "count" else rec.activity
+
+
+def band_of(rec: Recording) -> str:
+    """The labels' band (as evaluate's by_band): empty rooms apart, then by the labels' SNR."""
+    if rec.people == 0:
+        return "empty"
+    s = rec.snr_db
+    if s is None or s < 0:
+        return "<0 dB"
+    return "0-10 dB" if s < 10 else ">=10 dB"
+
+
+def write_fold_datasets(recs: list[Recording], task: str, root: Path, k: int) -> list[Path]:
+    """One dataset folder per fold under ``root`` (k <= 1: one folder holding every clip)."""
+    from wallcli.datagen.dataset import CLASSES, FORMAT, SHARD_FORMAT, VERSION
+    from wallcli.io.arrays import save_npz
+    from wallcli.io.writer import write_text_atomic
+
+    classes = CLASSES[task]
+    groups: dict[int, list[Recording]] = {}
+    for r in recs:
+        groups.setdefault(fold_of(r.name, k) if k > 1 else 0, []).append(r)
+    out = []
+    for f in range(max(k, 1)):
+        d = root / f"fold-{f}"
+        d.mkdir(parents=True, exist_ok=True)
+        members = groups.get(f, [])
+        if not members:
+            raise WallcliError(f"fold {f} of {k} holds no clips: too few labelled clips for {k} folds")
+        arrays = {"horizontal": np.concatenate([r.horizontal for r in members]),
+                  "vertical": np.concatenate([r.vertical for r in members]),
+                  "h_offset": np.concatenate([r.h_offset for r in members]),
+                  "v_offset": np.concatenate([r.v_offset for r in members])}
+        n = len(arrays["horizontal"])
+        lab = np.concatenate([[classes.index(truth(r, task))] * len(r.starts) for r in members]).astype(np.int64)
+        snr = np.concatenate([[np.nan if r.snr_db is None else r.snr_db] * len(r.starts) for r in members])
+        arrays.update(label=lab, people=np.concatenate([[r.people] * len(r.starts) for r in members]).astype(np.int64),
+                      activity=np.concatenate([[classes.index(r.activity) if task == "activity" else 0] * len(r.starts)
+                                               for r in members]).astype(np.int64),
+                      snr_db=snr.astype(np.float32), snr_db_weakest=snr.astype(np.float32))
+        scenes = [{"clip": r.name, "seed": "recordings", "index": r.name} for r in members for _ in r.starts]
+        save_npz(d / "shard-00000.npz", arrays, {"format": SHARD_FORMAT, "version": VERSION, "task": task,
+                                                 "seed": "recordings", "scenes": scenes}, force=True)
+        manifest = {"format": FORMAT, "version": VERSION, "task": task, "classes": classes, "window": WINDOW,
+                    "bins": BINS, "seed": f"recordings fold {f} of {k}", "complete": True,
+                    "recipe": {"recordings": sorted(r.name for r in members), "fold": f, "folds": k},
+                    "shards": [{"file": "shard-00000.npz", "n": n}]}
+        write_text_atomic(d / "dataset.json", json.dumps(manifest, indent=1), force=True)
+        out.append(d)
+    return out
+
+
+def clip_probabilities(model, rec: Recording) -> np.ndarray:
+    """The clip's answer as inference gives it: the mean of the model's window probabilities over
+    the windows at the card's stride (for a two-stage count, both nets' means, then combined)."""
+    ix = rec.eval_index(int(model.card["stride"]))
+    wins = {"horizontal": rec.horizontal[ix], "vertical": rec.vertical[ix]}
+    offs = {"horizontal": rec.h_offset[ix], "vertical": rec.v_offset[ix]}
+    raw = model.classify({n: wins[n] for n in model.input_names}, {n: offs[n] for n in model.input_names})
+    p = model.combine(raw.mean(axis=0))[0]
+    return p / p.sum()
+
+
+def clip_signal_db(model, rec: Recording) -> float:
+    """The clip's measured signal (the mean of its windows' ``window_signal_db``), as classify reports it."""
+    from wallcli.signal.window import window_signal_db
+
+    ix = rec.eval_index(int(model.card["stride"]))
+    parts = [(getattr(rec, n)[ix], (rec.h_offset if n == "horizontal" else rec.v_offset)[ix]) for n in model.input_names]
+    return round(float(np.mean(window_signal_db(parts))), 2)
+
+
+def wilson(k: int, n: int, z: float = 1.959963984540054) -> list[float] | None:
+    if n == 0:
+        return None
+    p = k / n
+    c = (p + z * z / (2 * n)) / (1 + z * z / n)
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return [round(max(0.0, c - h), 4), round(min(1.0, c + h), 4)]
+
+
+def oof_table(recs: list[Recording], answers: dict[str, dict], task: str, classes: list) -> dict[str, Any]:
+    """The card's ``recordings.out_of_fold`` block from per-clip answers {name: {label, confident}}."""
+    by_band, conf = {}, np.zeros((len(classes), len(classes)), np.int64)
+    det_right = det_n = dec_n = dec_right = 0
+    for name, lo, hi in BANDS:
+        sel = [r for r in recs if band_of(r) == name]
+        right = sum(answers[r.name]["label"] == truth(r, task) for r in sel)
+        dec = [r for r in sel if answers[r.name]["confident"]]
+        by_band[name] = {"right": int(right), "clips": len(sel), "decided": len(dec),
+                         "decided_right": int(sum(answers[r.name]["label"] == truth(r, task) for r in dec))}
+    for r in recs:
+        a = answers[r.name]
+        conf[classes.index(truth(r, task)), classes.index(a["label"])] += 1
+        if r.detectable is not False:
+            det_n += 1
+            det_right += a["label"] == truth(r, task)
+            if a["confident"]:
+                dec_n += 1
+                dec_right += a["label"] == truth(r, task)
+    return {"detectable": {"right": int(det_right), "clips": det_n,
+                           "accuracy": round(det_right / det_n, 4) if det_n else None, "ci95": wilson(det_right, det_n),
+                           "decided": dec_n, "decided_right": dec_right},
+            "by_band": by_band, "confusion_matrix": conf.tolist(),
+            "confusion_matrix_axes": "rows: true class, columns: answer, both in the order of classes"}
+
+
+def format_table(block: dict[str, Any], task: str) -> list[str]:
+    """The out-of-fold table as lines for the terminal."""
+    lines = [f"{'band':<10} {'right':>10} {'decided (right)':>16}"]
+    for name, b in block["by_band"].items():
+        lines.append(f"{name:<10} {b['right']:>4} of {b['clips']:<4} {b['decided']:>8} ({b['decided_right']})")
+    d = block["detectable"]
+    ci = d["ci95"] or [float("nan")] * 2
+    lines.append(f"{'detectable':<10} {d['right']:>4} of {d['clips']:<4} {d['decided']:>8} ({d['decided_right']})"
+                 f"   {d['accuracy'] or 0:.1%} (95 % CI {ci[0]:.0%}-{ci[1]:.0%})")
+    return lines
+
+
+def fit_trust(probs: np.ndarray, labels: np.ndarray, signal_db: np.ndarray, classes: list, *, level: float,
+              min_support: int = 10, edges=(0.0, 10.0)) -> dict[str, Any]:
+    """The card's ``confidence`` block fitted on out-of-fold clip answers: per band of measured
+    signal and answer, the lowest probability whose answers were right >= ``level`` with a 95 %
+    one-sided (Wilson) bound, on at least ``min_support`` clips; undetermined elsewhere."""
+    from wallcli.infer.confidence import fit
+
+    block = fit(probs, labels, signal_db, classes, level=level, edges=list(edges), min_support=min_support,
+                z=Z95_ONE_SIDED)
+    block["fitted_on"] = (f"out-of-fold answers on {len(labels)} labelled recordings (each answered by a model "
+                          "that never trained on it), one answer per clip")
+    return block
+
+
+def _identity(cfg, f: int, k: int, recs: list[Recording], extra: dict) -> str:
+    import hashlib
+    from dataclasses import asdict
+
+    from wallcli.infer.card import sha256_file
+
+    c = {key: str(v) for key, v in asdict(cfg).items() if key not in ("out", "checkpoint", "val", "data", "threads",
+                                                                     "checkpoint_minutes", "resume", "device")}
+    c.update(fold=f, folds=k, clips=sorted(r.name for r in recs), extra=extra,
+             init=sha256_file(Path(cfg.init)) if cfg.init else None)
+    return hashlib.sha256(json.dumps(c, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[Recording], work: Path, *,
+                   load, bars, log=None, extra: dict | None = None) -> dict[str, dict[str, Any]]:
+    """Out-of-fold answers {clip: {"probs", "signal_db", "fold"}}: for each fold, the net trained by
+    ``cfg`` on the other folds (and ``sim_data``), exported, loaded with ``load(path)`` as the
+    commands load it, answers the fold's clips. Each fold's answers are kept in ``work``: a rerun
+    (after Ctrl-C, or to train the final model) skips the folds already answered."""
+    from dataclasses import replace
+
+    from wallcli.io.writer import write_text_atomic
+    from wallcli.train.export import export_model
+    from wallcli.train.loop import train as run_training
+
+    k = len(fold_dirs)
+    answers: dict[str, dict[str, Any]] = {}
+    for f in range(k):
+        members = [r for r in recs if fold_of(r.name, k) == f]
+        ident = _identity(cfg, f, k, recs, extra or {})
+        done = work / f"fold-{f}.answers.json"
+        if done.is_file():
+            try:
+                got = json.loads(done.read_text(encoding="utf-8"))
+                if got.get("identity") == ident:
+                    answers.update(got["answers"])
+                    if log:
+                        log(f"fold {f + 1}/{k}: answers kept from an earlier run ({done})")
+                    continue
+            except (OSError, ValueError, KeyError):
+                pass  # damaged: trained again
+        if log:
+            log(f"fold {f + 1}/{k}: training on {sum(len(r.starts) for r in recs if r not in members)} windows of "
+                f"{len(recs) - len(members)} clips, answering {len(members)} clips")
+        onnx = work / f"fold-{f}.onnx"
+        fcfg = replace(cfg, data=[d for i, d in enumerate(fold_dirs) if i != f] + list(sim_data), val=fold_dirs[f],
+                       out=onnx, checkpoint=work / f"fold-{f}-{ident}.ckpt.pt")
+        with bars() as bar:
+            res = run_training(fcfg, bar.event)
+        export_model(res["net"], res["dataset"].inputs, onnx,
+                     {"name": f"fold-{f}", "version": "0", "task": cfg.task, "classes": res["dataset"].classes,
+                      "preprocessing": cfg.preprocessing, "stride": 64, "training_data": {"folds": [str(d) for d in fcfg.data]},
+                      "training": {"fold": f, "of": k}, "validation": None}, force=True, seed=cfg.seed)
+        model = load(onnx)
+        got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
+                        "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
+        write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
+        fcfg.checkpoint_path().unlink(missing_ok=True)
+        answers.update(got)
+    return answers
