@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from wallcli.errors import WallcliError
+from wallcli.io import jsonfile
 
 LABELS = "labels.csv"
 REQUIRED = ("file", "people", "activity")
@@ -168,7 +169,7 @@ def _from_sidecars(d: Path) -> tuple[list[Clip], list[tuple[str, str]]]:
 
 def _sidecar(d: Path, side: Path, beside: list[Path]) -> Clip:
     """The clip a sidecar labels; LookupError: not a sidecar at all."""
-    meta = json.loads(side.read_text(encoding="utf-8"))
+    meta = jsonfile.loads(side.read_text(encoding="utf-8"), allow_nan=True)
     keys = [k for k in ("people", "activity") if isinstance(meta, dict) and k in meta]
     if not keys:
         raise LookupError(side.name)

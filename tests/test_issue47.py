@@ -1,0 +1,60 @@
+"""Issue 47: inputs that hung, answered wrongly or crashed (one test or more per item)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clips import write_clip
+
+DEEP = "[" * 100_000 + "]" * 100_000
+
+
+def _one_line(err: str) -> bool:
+    return err.startswith("Error:") and "Traceback" not in err and "internal error" not in err
+
+
+# ------------------------------------------------------------------- 8: one JSON loader, depth-limited
+def test_json_loader_refuses_deep_nesting_as_bad_json():
+    from wallcli.io import jsonfile
+
+    for text in (DEEP, "[" * 65 + "]" * 65, '{"a":' * 500 + "1" + "}" * 500):
+        with pytest.raises(json.JSONDecodeError, match="nested more than 64 deep"):
+            jsonfile.loads(text)
+    assert jsonfile.loads("[" * 64 + "]" * 64) is not None
+    with pytest.raises(ValueError):
+        jsonfile.loads("[NaN]")
+    assert jsonfile.loads("[NaN]", allow_nan=True)[0] != 0
+
+
+def test_report_names_a_deep_results_line(tmp_path, run_cli):
+    res = tmp_path / "results.jsonl"
+    res.write_text(json.dumps({"input": "a.mp4", "error": "x is not a readable video"}) + "\n" + DEEP + "\n")
+    code, _, err = run_cli("report", res, "-o", tmp_path / "index.html")
+    assert code == 0, err
+    assert "line 2 is not JSON (nested more than 64 deep" in " ".join(err.split())
+    assert "RecursionError" not in err
+
+
+def test_scan_resume_refuses_a_deep_results_line(tmp_path, run_cli):
+    clip = write_clip(tmp_path / "a.mkv", lambda i: np.full((48, 64, 3), 128.0), 30)
+    res = tmp_path / "r.jsonl"
+    res.write_text(DEEP + "\n")
+    code, out, err = run_cli("scan", clip, "-o", res, "--task", "snr", "--workers", "1")
+    assert code == 1 and out == "" and _one_line(err), err
+    assert "line 1 is not a wallcli scan result" in err
+    assert res.read_text() == DEEP + "\n"  # left as it was
+
+
+def test_a_deep_sidecar_is_a_damaged_one(tmp_path):
+    from wallcli.evaluate.labels import read_labels
+
+    (tmp_path / "a.mp4").write_bytes(b"x")
+    (tmp_path / "a.json").write_text('{"people": 0, "activity": "none"}')
+    (tmp_path / "b.mp4").write_bytes(b"x")
+    (tmp_path / "b.json").write_text('{"people": 0, "activity": "none", "deep": ' + DEEP + "}")
+    labels = read_labels(tmp_path)
+    assert [c.file for c in labels.clips] == ["a.mp4"]
+    assert labels.damaged[0][0] == "b.mp4" and "nested more than 64 deep" in labels.damaged[0][1]
