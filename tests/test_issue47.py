@@ -58,3 +58,65 @@ def test_a_deep_sidecar_is_a_damaged_one(tmp_path):
     labels = read_labels(tmp_path)
     assert [c.file for c in labels.clips] == ["a.mp4"]
     assert labels.damaged[0][0] == "b.mp4" and "nested more than 64 deep" in labels.damaged[0][1]
+
+
+# ------------------------------------------------------------------- 6: one clip reached two ways
+def _labelled(tmp_path, third: str):
+    for v in ("a.mp4", "b.mp4"):
+        (tmp_path / v).write_bytes(b"not decoded here")
+    (tmp_path / "labels.csv").write_text(f"file,people,activity\na.mp4,1,walking\nb.mp4,0,none\n{third},1,walking\n")
+    return tmp_path
+
+
+@pytest.mark.parametrize("link", ["hard", "sym"])
+def test_a_clip_linked_twice_is_a_duplicate(tmp_path, link, run_cli):
+    from wallcli.errors import WallcliError
+    from wallcli.evaluate.labels import read_labels
+
+    d = _labelled(tmp_path, "c.mp4")
+    (d / "c.mp4").hardlink_to(d / "a.mp4") if link == "hard" else (d / "c.mp4").symlink_to(d / "a.mp4")
+    with pytest.raises(WallcliError, match="twice: line 2 .'a.mp4'. and line 4 .'c.mp4'."):
+        read_labels(d)
+    code, out, err = run_cli("evaluate", d, "--task", "count")
+    assert code == 1 and out == "" and _one_line(err) and len(err.splitlines()) == 1
+
+
+def test_a_copy_and_a_missing_clip_are_not_duplicates(tmp_path):
+    from wallcli.evaluate.labels import read_labels
+
+    d = _labelled(tmp_path, "c.mp4")
+    (d / "c.mp4").write_bytes((d / "a.mp4").read_bytes())  # same bytes, another file: two clips
+    (d / "labels.csv").write_text((d / "labels.csv").read_text() + "gone.mp4,0,none\n")
+    assert [c.file for c in read_labels(d).clips] == ["a.mp4", "b.mp4", "c.mp4", "gone.mp4"]
+
+
+# ------------------------------------------------------------------- 10: a huge line in labels.csv
+def test_a_huge_labels_line_is_refused_early_naming_it(tmp_path, run_cli):
+    import tracemalloc
+
+    from wallcli.errors import WallcliError
+    from wallcli.evaluate.labels import read_labels
+
+    d = _labelled(tmp_path, "b.mp4")
+    with open(d / "labels.csv", "w") as f:
+        f.write("file,people,activity\na.mp4,1,walking\n" + "x" * (32 << 20) + ",0,none\n")
+    tracemalloc.start()
+    try:
+        with pytest.raises(WallcliError, match=r"labels.csv line 3 is longer than"):
+            read_labels(d)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 4 << 20  # the 32 MB line was never held
+    code, out, err = run_cli("evaluate", d, "--task", "count")
+    assert code == 1 and out == "" and _one_line(err) and "line 3" in err
+
+
+def test_a_quoted_cell_over_many_lines_names_where_it_failed(tmp_path):
+    from wallcli.errors import WallcliError
+    from wallcli.evaluate.labels import read_labels
+
+    d = _labelled(tmp_path, "b.mp4")
+    (d / "labels.csv").write_text('file,people,activity\na.mp4,1,walking\n"' + "x\n" * 80_000 + '",0,none\n')
+    with pytest.raises(WallcliError, match=r"labels.csv line \d+: field larger than field limit"):
+        read_labels(d)
