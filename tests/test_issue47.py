@@ -120,3 +120,61 @@ def test_a_quoted_cell_over_many_lines_names_where_it_failed(tmp_path):
     (d / "labels.csv").write_text('file,people,activity\na.mp4,1,walking\n"' + "x\n" * 80_000 + '",0,none\n')
     with pytest.raises(WallcliError, match=r"labels.csv line \d+: field larger than field limit"):
         read_labels(d)
+
+
+# ------------------------------------------------------------------- 11: FIFOs and devices are streams
+@pytest.fixture(scope="module")
+def mkv(tmp_path_factory) -> Path:
+    return write_clip(tmp_path_factory.mktemp("i47") / "c.mkv", lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)), 300)
+
+
+def _stplot_json(run_cli, source) -> dict:
+    code, out, err = run_cli("stplot", source, "--json")
+    assert code == 0, err
+    return json.loads(out)
+
+
+def test_a_fifo_carrying_a_video_is_read_as_a_stream(mkv, tmp_path, run_cli):
+    import os
+    import threading
+
+    fifo = tmp_path / "pipe.mkv"
+    os.mkfifo(fifo)
+
+    def feed():
+        with open(fifo, "wb") as f:
+            try:
+                f.write(mkv.read_bytes())
+            except BrokenPipeError:
+                pass
+
+    t = threading.Thread(target=feed, daemon=True)
+    t.start()
+    try:
+        got = _stplot_json(run_cli, fifo)
+    finally:
+        if t.is_alive():  # the reader never opened it: let the writer go
+            os.close(os.open(fifo, os.O_RDONLY | os.O_NONBLOCK))
+        t.join(5)
+    assert got["frames"] == _stplot_json(run_cli, mkv)["frames"] > 100
+
+
+@pytest.mark.parametrize("how", ["/dev/stdin", "/dev/fd/N"])
+def test_dev_stdin_and_process_substitution_are_read(mkv, how):
+    import os
+    import subprocess
+    import sys
+
+    r, w = os.pipe()
+    source = "/dev/stdin" if how == "/dev/stdin" else f"/dev/fd/{r}"
+    p = subprocess.Popen([sys.executable, "-m", "wallcli", "stplot", source, "--json"], stdin=r if how == "/dev/stdin"
+                         else subprocess.DEVNULL, pass_fds=(r,), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    os.close(r)
+    try:
+        with os.fdopen(w, "wb") as f:
+            f.write(mkv.read_bytes())
+    except BrokenPipeError:
+        pass
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err.decode()
+    assert json.loads(out)["frames"] > 100

@@ -136,7 +136,9 @@ class VideoReader:
                 raise WallcliError(f"no such file: {source}")
             if p.is_dir():
                 raise WallcliError(f"{source} is a folder, not a video")
-            if p.stat().st_size == 0:
+            # only a regular file's size means anything: a FIFO, <(...), /dev/stdin or a device
+            # reports 0 and is read as a stream
+            if p.is_file() and p.stat().st_size == 0:
                 raise WallcliError(f"{source} is empty (0 bytes)")
         try:
             self._container = av.open(target, mode="r", format=fmt, options=options, timeout=30.0)
