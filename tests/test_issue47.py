@@ -178,3 +178,22 @@ def test_dev_stdin_and_process_substitution_are_read(mkv, how):
     out, err = p.communicate(timeout=120)
     assert p.returncode == 0, err.decode()
     assert json.loads(out)["frames"] > 100
+
+
+# ------------------------------------------------------------------- 12: a reader that left
+@pytest.mark.parametrize("args", [["count", "{clip}", "--follow"], ["stplot", "{clip}", "--json"], ["--help"]])
+def test_a_closed_stdout_pipe_says_so_in_one_line(mkv, args):
+    import os
+    import subprocess
+    import sys
+
+    r, w = os.pipe()
+    os.close(r)  # the reader has gone before the first write: EPIPE, deterministically
+    try:
+        p = subprocess.run([sys.executable, "-m", "wallcli", *(a.format(clip=mkv) for a in args)], stdout=w,
+                           stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(w)
+    assert p.returncode == 1, p.stderr
+    assert "Error: stdout was closed by its reader before the output was complete" in p.stderr
+    assert "Traceback" not in p.stderr and p.stderr.count("Error:") == 1, p.stderr
