@@ -197,3 +197,44 @@ def test_a_closed_stdout_pipe_says_so_in_one_line(mkv, args):
     assert p.returncode == 1, p.stderr
     assert "Error: stdout was closed by its reader before the output was complete" in p.stderr
     assert "Traceback" not in p.stderr and p.stderr.count("Error:") == 1, p.stderr
+
+
+# ------------------------------------------------------------------- 13: one rule per option, in --help
+@pytest.mark.parametrize("command", ["count", "stplot", "snr", "amplify"])
+def test_roi_rules_are_the_same_everywhere(mkv, tmp_path, run_cli, command):
+    extra = {"count": ["--json"], "stplot": ["--json"], "snr": ["--json"], "amplify": [tmp_path / "o.mp4"]}[command]
+    code, out, err = run_cli(command, mkv, *extra, "--roi", "")
+    assert code == 2 and out == "" and "--roi must be four integers" in err and len(err.splitlines()) == 1
+    for roi in ("0,0,1,1", "0,0,1,40", "5,5,40,1"):
+        code, out, err = run_cli(command, mkv, *extra, "--roi", roi)
+        assert code == 1 and out == "", (roi, err)
+        assert f"ROI {roi} is smaller than 2x2 pixels" in err and "64x48" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "o.mp4").exists()
+
+
+@pytest.mark.parametrize("args", [["count", "{clip}", "--plot", "x.txt"], ["snr", "{clip}", "--heatmap", "x.jpg"],
+                                  ["snr", "--predict", "--plot", "x"], ["stplot", "{clip}", "--png", "x.npz"],
+                                  ["evaluate", "{folder}", "--task", "count", "--plot", "x.svg"]])
+def test_a_figure_name_must_say_png(mkv, tmp_path, run_cli, args, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(*(a.format(clip=mkv, folder=mkv.parent) for a in args))
+    assert code == 2 and out == "" and "writes a PNG; its name must end in .png" in err
+    assert not any(tmp_path.iterdir())
+    command = [a for a in args if not a.startswith("{")][0]
+    code, out, _ = run_cli(command, "--help")
+    assert code == 0 and "must end in .png" in " ".join(out.split())
+
+
+def test_amplify_writes_the_size_asked_or_refuses(mkv, tmp_path, run_cli):
+    from wallcli.cli.amplify import parse_scale
+    from wallcli.errors import UsageError
+
+    for text in ("1x1", "65x48", "64x3"):
+        with pytest.raises(UsageError, match="even width and height"):
+            parse_scale(text, 64, 48)
+    assert parse_scale("2x2", 64, 48) == (2, 2) and parse_scale("0.5", 64, 48) == (32, 24)
+    assert parse_scale("0.01", 64, 48) == (2, 2)  # a factor is rounded, as --help says
+    code, out, err = run_cli("amplify", mkv, tmp_path / "o.mp4", "--scale", "1x1")
+    assert code == 2 and "even width and height" in err and not (tmp_path / "o.mp4").exists()
+    code, out, _ = run_cli("amplify", "--help")
+    assert "even numbers" in " ".join(out.split())
