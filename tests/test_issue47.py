@@ -238,3 +238,19 @@ def test_amplify_writes_the_size_asked_or_refuses(mkv, tmp_path, run_cli):
     assert code == 2 and "even width and height" in err and not (tmp_path / "o.mp4").exists()
     code, out, _ = run_cli("amplify", "--help")
     assert "even numbers" in " ".join(out.split())
+
+
+# ------------------------------------------------------------------- 4: a bare .h264 stream's rate
+@pytest.mark.parametrize("fps", [30, 24])
+def test_a_bare_h264_stream_is_read_at_its_codec_rate(tmp_path, run_cli, fps):
+    clip = write_clip(tmp_path / "r.h264", lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)), 400,
+                      fmt="h264", fps=fps)
+    out = _stplot_json(run_cli, clip)
+    assert out["fps"] == fps and out["fps_source"] == "codec"
+    assert out["duration"] == pytest.approx(399 / fps, abs=0.15)  # at 25 fps: 15.9 s
+    assert any("codec headers" in w for w in out["warnings"])
+    assert _stplot_json(run_cli, mkv_of(tmp_path, fps))["fps_source"] == "container"
+
+
+def mkv_of(tmp_path, fps):
+    return write_clip(tmp_path / "m.mkv", lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)), 60, fps=fps)

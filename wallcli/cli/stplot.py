@@ -123,7 +123,7 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
         emit_json({
             "input": input, "output": str(output) if output else None, "png": str(png) if png else None,
             "frames": plot.frames, "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
-            "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
+            "fps_source": m.get("fps_source", "container"), "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
             "signal_rms": [float(x) for x in plot.horizontal.std(axis=(0, 1))],
             "warnings": m.get("warnings", []),
             "view": check_summary(m),

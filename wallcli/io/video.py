@@ -66,6 +66,7 @@ class VideoInfo:
     duration: float | None
     codec: str = ""  # FFmpeg's decoder name, e.g. 'h264' (for reports of the evidence)
     container: str = ""  # FFmpeg's demuxer name, e.g. 'mov,mp4,m4a,3gp,3g2,mj2'
+    fps_source: str = "container"  # where fps came from: 'container', 'codec' (its headers) or 'assumed'
 
 
 @dataclass
@@ -83,6 +84,13 @@ class Frame:
 GAP_FACTOR = 5.0
 GAP_MIN = 0.25
 GAP_HISTORY = 16  # recent intervals whose median is the typical one
+
+# FFmpeg's demuxers of bare elementary streams: no timestamps, and an average_rate that is only
+# the demuxer's -framerate default (25), whatever the frames are; the codec's headers (H.264's
+# VUI timing, MPEG-2's sequence header) are what knows the rate
+RAW_DEMUXERS = frozenset({"h264", "hevc", "vvc", "m4v", "mpegvideo", "cavsvideo", "avs2", "avs3", "vc1", "dirac",
+                          "mjpeg", "dnxhd"})
+RAW_DEFAULT_FPS = 25  # what FFmpeg assumes for such a stream that states no rate
 
 
 def _real_video(stream) -> bool:
@@ -155,15 +163,29 @@ class VideoReader:
         stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
         stream.codec_context.thread_count = int(threads)
         self._stream = stream
-        rate = stream.average_rate or stream.guessed_rate or stream.base_rate
+        fps_source = "container"
+        container_name = str(self._container.format.name or "")
+        raw = container_name in RAW_DEMUXERS
+        rate = None if raw else stream.average_rate
+        if raw:
+            stated = stream.codec_context.framerate
+            if stated and stated > 0:
+                rate, fps_source = stated, "codec"
+                self.warnings.append(f"{source}: a bare {container_name} stream has no timestamps; read at "
+                                     f"{float(stated):.4g} fps, the rate its codec headers state")
+            else:
+                rate, fps_source = Fraction(RAW_DEFAULT_FPS), "assumed"
+                self._warn(f"{source}: a bare {container_name} stream states no frame rate; assuming "
+                           f"{RAW_DEFAULT_FPS} fps (FFmpeg's default): times and rates are wrong if it is not")
+        rate = rate or stream.guessed_rate or stream.base_rate
         if not rate or rate <= 0:
-            rate = Fraction(30)
+            rate, fps_source = Fraction(30), "assumed"
             self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
         fps = Fraction(rate).limit_denominator(1001)
         try:
-            # the measured rate only: a container that gives none leaves FFmpeg guessing from its time
-            # base (Matroska's 1000), which says nothing of the frames
-            if stream.average_rate:
+            # the measured or stated rate only: a container that gives none leaves FFmpeg guessing
+            # from its time base (Matroska's 1000), which says nothing of the frames
+            if stream.average_rate or fps_source == "codec":
                 check_rate(fps, source)
         except WallcliError:
             self._container.close()
@@ -187,7 +209,8 @@ class VideoReader:
             pix_fmt=str(cc.pix_fmt or ""),
             duration=duration,
             codec=str(cc.name or ""),
-            container=str(self._container.format.name or ""),
+            container=container_name,
+            fps_source=fps_source,
         )
         self.rotation = 0  # quarter turns (np.rot90's k) applied to every frame: its display matrix
         self._rotation_noted = False
