@@ -254,3 +254,32 @@ def test_a_bare_h264_stream_is_read_at_its_codec_rate(tmp_path, run_cli, fps):
 
 def mkv_of(tmp_path, fps):
     return write_clip(tmp_path / "m.mkv", lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)), 60, fps=fps)
+
+
+# ------------------------------------------------------------------- 7: the frame size changes mid-stream
+@pytest.fixture(scope="module")
+def two_sizes(tmp_path_factory) -> Path:
+    d = tmp_path_factory.mktemp("sizes")
+    a = write_clip(d / "a.ts", lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)), 300, fmt="mpegts")
+    b = write_clip(d / "b.ts", lambda i: np.full((72, 96, 3), 100 + 5 * np.sin(i / 5)), 300, fmt="mpegts")
+    (d / "ab.ts").write_bytes(a.read_bytes() + b.read_bytes())
+    return d / "ab.ts"
+
+
+SIZE_LINE = "the frame size changes from 64x48 to 96x72 at frame 300"
+
+
+@pytest.mark.parametrize("command", ["count", "stplot", "snr", "report", "amplify"])
+def test_a_frame_size_change_is_one_clear_line_everywhere(two_sizes, tmp_path, run_cli, command):
+    out_file = {"report": ["-o", tmp_path / "r.html"], "amplify": [tmp_path / "o.mp4"]}.get(command, ["--json"])
+    code, out, err = run_cli(command, two_sizes, *out_file)
+    assert code == 1 and out == "" and _one_line(err), err
+    assert SIZE_LINE in err and [line for line in err.splitlines() if line.startswith("Error:")] == err.splitlines()[-1:]
+    assert not any(tmp_path.iterdir())  # amplify wrote nothing at the first size
+
+
+def test_scan_gives_the_video_its_error_line(two_sizes, tmp_path, run_cli):
+    res = tmp_path / "r.jsonl"
+    run_cli("scan", two_sizes, "-o", res, "--task", "snr", "--workers", "1")
+    (line,) = [json.loads(s) for s in res.read_text().splitlines()]
+    assert SIZE_LINE in line["error"] and "internal error" not in line["error"]

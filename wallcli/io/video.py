@@ -323,6 +323,7 @@ class VideoReader:
 
         recent: deque = deque(maxlen=GAP_HISTORY)
         self.gaps = []
+        size = None  # (width, height) of the first frame: every analysis holds per-pixel state of that size
         try:
             while True:
                 kind, item = q.get()
@@ -347,7 +348,12 @@ class VideoReader:
                         else:
                             recent.append(dt)
                     last_time = t
-                    yield Frame(index, t, self._turn(frame, frame_planes(frame)), frame, gap)
+                    planes = self._turn(frame, frame_planes(frame))
+                    if size is None:
+                        size = (planes.width, planes.height)
+                    elif (planes.width, planes.height) != size:
+                        raise self._size_changed(index, t, size, (planes.width, planes.height))
+                    yield Frame(index, t, planes, frame, gap)
                     index += 1
                 elif kind == "damage":
                     if index == 0 and self._mp4_on_a_pipe():
@@ -370,6 +376,13 @@ class VideoReader:
             self._stop_worker()
         if index == 0:
             raise WallcliError(f"{self.source}: no frames could be decoded")
+
+    def _size_changed(self, index: int, t: float, old: tuple[int, int], new: tuple[int, int]) -> WallcliError:
+        """One line for every command: the block grids, plots and frames written so far all have the
+        first size, and no analysis spans two views of a wall."""
+        return WallcliError(f"{self.source}: the frame size changes from {old[0]}x{old[1]} to {new[0]}x{new[1]} at "
+                            f"frame {index} ({t:.2f} s); wallcli analyses a video of one frame size",
+                            hint=f"cut it there and analyse each part, e.g. ffmpeg -i IN -t {t:.2f} -c copy part1.ts")
 
     def _mp4_on_a_pipe(self) -> bool:
         """An MP4 (or MOV) read from stdin: its index usually sits at the end of the file, where a
