@@ -283,3 +283,35 @@ def test_scan_gives_the_video_its_error_line(two_sizes, tmp_path, run_cli):
     run_cli("scan", two_sizes, "-o", res, "--task", "snr", "--workers", "1")
     (line,) = [json.loads(s) for s in res.read_text().splitlines()]
     assert SIZE_LINE in line["error"] and "internal error" not in line["error"]
+
+
+# ------------------------------------------------------------------- 5: too small for the camera-motion check
+def _pan(tmp_path, w, h):
+    import cv2
+
+    tex = cv2.GaussianBlur(np.random.default_rng(1).normal(128, 30, (200, 400, 3)), (0, 0), 2)
+    return write_clip(tmp_path / f"pan{w}x{h}.nut", lambda i: tex[50:50 + h, 10 + i:10 + i + w], 120, fps=30,
+                      codec="rawvideo", pix_fmt="yuv444p", options={})
+
+
+@pytest.mark.parametrize("w,h", [(30, 30), (8, 8), (3, 5)])
+def test_a_pan_too_small_to_check_is_not_called_usable(tmp_path, run_cli, w, h):
+    code, out, err = run_cli("snr", _pan(tmp_path, w, h), "--json")
+    assert code == 0, err
+    view = json.loads(out)["view"]
+    assert view["usable"] is False and "too small to check" in view["issues"]
+    assert "too small to check for camera motion" in view["reason"]
+
+
+def test_a_pan_large_enough_is_still_caught(tmp_path, run_cli):
+    code, out, err = run_cli("snr", _pan(tmp_path, 40, 40), "--json")
+    view = json.loads(out)["view"]
+    assert view["usable"] is False and "camera motion" in view["issues"] and "too small to check" not in view["issues"]
+
+
+def test_a_tiny_roi_is_too_small_to_check(mkv, run_cli):
+    code, out, err = run_cli("count", mkv, "--json", "--roi", "2,2,8,8")
+    assert code == 0, err
+    res = json.loads(out)
+    assert res["view"]["usable"] is False and "too small to check" in res["view"]["issues"]
+    assert res["confident"] is False
