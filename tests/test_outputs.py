@@ -32,7 +32,8 @@ def test_check_outputs(tmp_path):
 
 
 def test_stplot_same_output_twice(tmp_path, run_cli, clip):
-    code, out, err = run_cli("stplot", clip, "-o", tmp_path / "x.npz", "--png", tmp_path / "x.npz")
+    (tmp_path / "x.png").symlink_to(tmp_path / "x.npz")  # --png must end in .png: one file by two names
+    code, out, err = run_cli("stplot", clip, "-o", tmp_path / "x.npz", "--png", tmp_path / "x.png")
     assert code == 2 and "two outputs" in err and out == ""
     assert not (tmp_path / "x.npz").exists()
 
@@ -53,7 +54,8 @@ def test_simulate_preview_on_the_sidecar_or_video(tmp_path, run_cli, preview):
 def test_count_plot_over_the_model_is_refused(tmp_path, run_cli, clip):
     model = tmp_path / "m.onnx"
     model.write_bytes(b"not a model")
-    code, _, err = run_cli("count", clip, "--model", model, "--plot", model, "--force")
+    (tmp_path / "m.png").symlink_to(model)  # --plot must end in .png: the model by another name
+    code, _, err = run_cli("count", clip, "--model", model, "--plot", tmp_path / "m.png", "--force")
     assert code == 1 and "is the input" in err and model.read_bytes() == b"not a model"
 
 

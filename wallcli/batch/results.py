@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from wallcli.errors import WallcliError
+from wallcli.io import jsonfile
 from wallcli.io.text import escape_surrogates, unescape_surrogates
 
 BASE = ["input", "size", "sha256", "duration", "frames", "tasks", "options", "seconds", "error", "warnings"]
@@ -125,7 +126,7 @@ def _models(d: dict) -> dict:
 
 def _entry_json(raw: str) -> Entry | None:
     try:
-        d = json.loads(raw)
+        d = jsonfile.loads(raw, allow_nan=True)
     except json.JSONDecodeError:
         return None
     if not isinstance(d, dict) or not isinstance(d.get("input"), str) or not isinstance(d.get("tasks"), list):
@@ -145,7 +146,7 @@ def _entry_csv(row: list[str], header: list[str]) -> Entry | None:
     except ValueError:
         return None
     try:
-        options = json.loads(d["options"]) if d.get("options") else None
+        options = jsonfile.loads(d["options"], allow_nan=True) if d.get("options") else None
     except json.JSONDecodeError:
         options = None
     models = {t: d[f"{t}.model.sha256"] for t in ("count", "activity") if d.get(f"{t}.model.sha256")}

@@ -10,7 +10,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (ROI_HELP, corrections_of, deflicker_option, exposure_option, force_help, input_argument,
+from wallcli.cli.common import (PNG_NAME, ROI_HELP, check_png_names, corrections_of, deflicker_option, exposure_option, force_help, input_argument,
                                 shake_option,
                                 number_option, parse_roi, refuse_view, strict_option, threads_option)
 
@@ -19,7 +19,7 @@ STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
                            help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
 JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see docs/contract.md).")
 PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
-                        "(for a video, the plot drawn is averaged down to at most 2048 time columns).")
+                        "(for a video, the plot drawn is averaged down to at most 2048 time columns). " + PNG_NAME)
 MODEL_OPT = typer.Option(None, "--model", help="Your own .onnx model; its card (same name, .json) must be beside it.")
 ACTIVITY_MODEL_OPT = typer.Option(None, "--activity-model", help="The activity model of the two-stage count's "
                                   "presence stage (default: the shipped one). Answers are decided only with the "
@@ -64,6 +64,7 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     reads = [input, model_path or shipped_model_path(task)]
     if task == "count" and not single_stage:
         reads.append(activity_model or shipped_model_path("activity"))
+    check_png_names(("--plot", plot))
     check_outputs([plot], force=force, inputs=reads)
     model = load_classifier(task, model_path, threads=threads, activity_path=activity_model, single=single_stage)
     stride = int(stride or model.card["stride"])

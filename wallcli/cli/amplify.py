@@ -17,7 +17,9 @@ SIDE_BUFFER_BYTES = 64 * 1024 * 1024
 
 
 def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
-    """'0.5' (factor) or '640x360' (pixels) -> even (width, height) for H.264 4:2:0."""
+    """'0.5' (factor) or '640x360' (pixels) -> even (width, height) for H.264 4:2:0. A factor's
+    size is rounded to even numbers (at least 2); a size given in pixels is written as given or
+    refused, never silently changed."""
     from wallcli.errors import UsageError
 
     t = text.strip().lower()
@@ -25,6 +27,9 @@ def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
         if "x" in t:
             w_s, h_s = t.split("x", 1)
             w, h = float(int(w_s)), float(int(h_s))
+            if w > 0 and h > 0 and (w % 2 or h % 2):
+                raise UsageError(f"--scale {text}: H.264 (4:2:0) needs an even width and height, of 2 or more "
+                                 f"(e.g. {max(2, 2 * round(w / 2))}x{max(2, 2 * round(h / 2))})")
         else:
             f = float(t)
             w, h = width * f, height * f
@@ -50,7 +55,8 @@ def amplify(
     mean_seconds: float = number_option(10.0, "--mean-seconds", lo=0.01, hi=3600, help="Time constant of 'ema' / span of 'window'."),
     smooth: float = number_option(0.0, "--smooth", lo=0, hi=3600, help="Temporal smoothing time constant in seconds "
                                  "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion."),
-    scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5) or WIDTHxHEIGHT."),
+    scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5; rounded to even sizes, at least 2x2) or "
+                       "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0)."),
     side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Output shows the ROI only."),
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),

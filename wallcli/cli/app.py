@@ -147,7 +147,7 @@ def _run(argv: list[str] | None) -> int:
 
 
 def _run_command(argv: list[str] | None) -> int:
-    from wallcli.cli.output import StdoutError, abandon_stdout, guarded_stdout, printable
+    from wallcli.cli.output import READER_LEFT, StdoutError, abandon_stdout, guarded_stdout, printable
     from wallcli.errors import WallcliError, raise_if_interrupted
 
     Abort, ClickException, Exit, ClickUsageError = _click_exceptions()
@@ -209,8 +209,11 @@ def _run_command(argv: list[str] | None) -> int:
         _say("interrupted")
         return 1
     except BrokenPipeError:
-        # `wallcli ... | head`: the reader left; not our failure, and nothing to tell it.
+        # `wallcli ... | head`: the reader left before the output was whole. Not a success (a
+        # Unix tool would die of SIGPIPE, a non-zero status; the contract's is 1), so say so in
+        # the one line every failure gets: a bare 1 looked like a crash with nothing to read.
         abandon_stdout()
+        _say(READER_LEFT)
         return 1
     except MemoryError:
         if _debug():

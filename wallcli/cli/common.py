@@ -9,7 +9,10 @@ import typer
 
 from wallcli.errors import UsageError
 
-ROI_HELP = "Region of the wall to analyse, x,y,w,h in source pixels (origin top-left). Default: whole frame."
+ROI_HELP = ("Region of the wall to analyse, x,y,w,h in source pixels (origin top-left), at least 2x2 pixels "
+            "(one chroma sample of 4:2:0 video). Default: whole frame.")
+# said in the help of every option that draws a figure (check_png_names enforces it)
+PNG_NAME = "The name must end in .png."
 
 
 def force_help(what: str) -> str:
@@ -95,8 +98,8 @@ THREADS_HELP = "Decoder threads (0 = FFmpeg chooses)."
 
 def parse_roi(text: str | None) -> tuple[int, int, int, int] | None:
     """'x,y,w,h' -> ints; malformed text is a usage error (exit 2), out-of-frame is checked later."""
-    if text is None or text == "":
-        return None
+    if text is None:
+        return None  # an empty --roi "" is malformed (a script's unset variable), not the whole frame
     parts = text.replace(" ", "").split(",")
     try:
         values = tuple(int(p) for p in parts)
@@ -105,6 +108,14 @@ def parse_roi(text: str | None) -> tuple[int, int, int, int] | None:
     if len(values) != 4:
         raise UsageError(f"--roi must be four integers x,y,w,h (got {text!r})")
     return values  # type: ignore[return-value]
+
+
+def check_png_names(*named) -> None:
+    """(flag, path) pairs of figure outputs: a figure is PNG whatever the name says, so a name that
+    says otherwise (x.txt, x.jpg) is refused before any work (exit 2)."""
+    for flag, path in named:
+        if path is not None and os.path.splitext(str(path))[1].lower() != ".png":
+            raise UsageError(f"{flag} writes a PNG; its name must end in .png (got {str(path)!r})")
 
 
 def input_argument(help_text: str = "Video file, http(s)/rtsp URL, or '-' for a stream on stdin."):

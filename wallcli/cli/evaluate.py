@@ -6,7 +6,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (MAX_THREADS, ROI_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (MAX_THREADS, PNG_NAME, ROI_HELP, check_png_names, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 number_option, strict_option)
 
 PROGRESS_DELAY = 2.0  # seconds before the progress bar appears
@@ -22,7 +22,7 @@ def evaluate(
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (docs/contract.md), rows included."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw a reliability diagram (confidence of the clip "
                                         "answers against how often they are right) and accuracy against measured "
-                                        "SNR to this PNG."),
+                                        "SNR to this PNG. " + PNG_NAME),
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
                               help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
     min_snr: Optional[float] = number_option(None, "--min-snr", lo=-99, hi=99, help="Score only empty rooms and "
@@ -82,6 +82,7 @@ def evaluate(
     from wallcli.evaluate.run import plan_folder
     from wallcli.io.writer import check_outputs
 
+    check_png_names(("--plot", plot))
     plan = plan_folder(folder, task, min_snr=min_snr)  # fails early (exit 1) on a folder without labels
     for file, why in plan.labels.damaged:
         warn(f"{file} skipped: {why}")

@@ -118,6 +118,9 @@ def print_lines(lines: list[str], *, hang: int = 0) -> None:
 
 
 # --------------------------------------------------------------------------------------- stdout
+READER_LEFT = "stdout was closed by its reader before the output was complete"
+
+
 class StdoutError(WallcliError):
     """stdout cannot take the data: the user's environment (a full disk, a closed stdout), not a bug."""
 
@@ -131,8 +134,9 @@ def _reason(exc: BaseException | None) -> str:
 
 class _GuardedStdout:
     """sys.stdout while a command runs: a failed write or flush raises :class:`StdoutError`
-    (one error line, exit 1) wherever it happens (our JSON and tables, click's help, print);
-    a reader that went away (BrokenPipeError) is left to main(), which ends quietly."""
+    (one error line, exit 1) wherever it happens (our JSON and tables, click's help, print),
+    a reader that went away (BrokenPipeError) included: click would catch that one itself and
+    exit 1 saying nothing."""
 
     def __init__(self, stream) -> None:
         self._stream = stream
@@ -143,7 +147,7 @@ class _GuardedStdout:
         try:
             return getattr(self._stream, name)(*args)
         except BrokenPipeError:
-            raise
+            raise StdoutError(READER_LEFT) from None
         except UnicodeError:
             raise
         except (OSError, ValueError) as exc:  # ValueError: write to a closed file

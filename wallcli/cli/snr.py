@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (stream_option, THREADS_HELP, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (stream_option, PNG_NAME, THREADS_HELP, check_png_names, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 number_option, strict_option, threads_option)
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
@@ -44,17 +44,17 @@ def _predict_option(name: str):
 
 def snr(
     input: Optional[str] = typer.Argument(None, help="Video file, http(s)/rtsp URL, or '-' (not needed with --predict).", show_default=False),
-    roi: Optional[str] = typer.Option(None, "--roi", metavar="X,Y,W,H|auto", help="x,y,w,h in source pixels, or 'auto': the rectangle of whole grid cells "
+    roi: Optional[str] = typer.Option(None, "--roi", metavar="X,Y,W,H|auto", help="x,y,w,h in source pixels (at least 2x2), or 'auto': the rectangle of whole grid cells "
                                       "(up to 16x16 cells over the frame) whose spatially averaged grey level has the highest SNR "
                                       "(signal power / noise power of the rectangle's mean, computed exactly from the cells' temporal "
                                       "covariances), leaving out cells where the view check saw a moving object, clipping or black. "
                                       f"'auto' reads the file twice and is at least {AUTO_MIN_PX} px on each side (the "
                                       "frame's side if smaller), so the plots' 64 bins hold a pixel each. Default: whole frame."),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object (docs/contract.md fields, plus extras) on stdout."),
-    heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG."),
+    heatmap: Optional[Path] = typer.Option(None, "--heatmap", help="Draw signal power (or SNR, --heatmap-of) per grid cell over the mean frame to this PNG. " + PNG_NAME),
     heatmap_of: str = typer.Option("signal", "--heatmap-of", help="What the heatmap shows: 'signal' (power, code values^2) or 'snr' (dB)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw SNR and noise power against block size (log-log) beside the white-noise law; "
-                                        "with --predict --sweep, SNR against the swept parameter (signal power without --mean-code and --gain)."),
+                                        "with --predict --sweep, SNR against the swept parameter (signal power without --mean-code and --gain). " + PNG_NAME),
     max_pixels: int = number_option(32768, "--max-pixels", lo=0, hi=2**31, integer=True, help="Pixels measured per frame: a larger ROI is sampled by a regular "
                                    "lattice of 32x32 tiles (an unbiased estimate of the per-pixel averages, and what keeps 1080p at "
                                    "decode speed). 0 = every pixel of the ROI (exact, slower)."),
@@ -106,6 +106,7 @@ def snr(
     from wallcli.errors import UsageError
     from wallcli.io.writer import committed_together
 
+    check_png_names(("--heatmap", heatmap), ("--plot", plot))
     if heatmap_of not in ("signal", "snr"):
         raise UsageError(f"--heatmap-of must be signal or snr (got {heatmap_of!r})")
     if predict_mode:

@@ -7,13 +7,13 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import stream_option, ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, PNG_NAME, ROI_HELP, check_png_names, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
     input: str = input_argument(),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="Write the plots to this .npz (float32 arrays + JSON metadata)."),
-    png: Optional[Path] = typer.Option(None, "--png", help="Draw both plots, amplified, to this PNG."),
+    png: Optional[Path] = typer.Option(None, "--png", help="Draw both plots, amplified, to this PNG. " + PNG_NAME),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
     bins: int = number_option(64, "--bins", lo=2, hi=4096, integer=True, help="Positions per plot (the networks use 64)."),
     mean: str = typer.Option("clip", "--mean", help="Temporal mean removal: 'clip' (whole recording; files), "
@@ -54,6 +54,7 @@ def stplot(
         raise UsageError(f"--style must be rgb or diverging (got {style!r})")
     if output is not None and output.suffix.lower() != ".npz":
         raise UsageError(f"-o must end in .npz (got {output})")
+    check_png_names(("--png", png))
     roi_t = parse_roi(roi)
 
     from wallcli.cli.output import progress
@@ -122,7 +123,7 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
         emit_json({
             "input": input, "output": str(output) if output else None, "png": str(png) if png else None,
             "frames": plot.frames, "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
-            "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
+            "fps_source": m.get("fps_source", "container"), "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
             "signal_rms": [float(x) for x in plot.horizontal.std(axis=(0, 1))],
             "warnings": m.get("warnings", []),
             "view": check_summary(m),

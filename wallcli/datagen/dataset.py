@@ -18,6 +18,7 @@ import numpy as np
 
 from wallcli.datagen.clips import BINS, COUNT_ACTS, FPS, WINDOW, render_windows
 from wallcli.datagen.ptcache import FORMAT as PT_FORMAT, VERSION as PT_VERSION
+from wallcli.io import jsonfile
 from wallcli.sim.motion import ACTIVITIES
 
 FORMAT, VERSION = "wallcli.dataset", 1
@@ -120,8 +121,8 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
     manifest_path = out / "dataset.json"
     if manifest_path.exists() and not force:
         try:
-            old = json.loads(manifest_path.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
+            old = jsonfile.loads(manifest_path.read_text(encoding="utf-8"), allow_nan=True)
+        except (OSError, ValueError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
             raise WallcliError(f"{manifest_path} is unreadable ({exc})", hint="use --force to start over") from exc
         if old.get("recipe") != rec:
             raise WallcliError(f"{out} holds a different dataset ({old.get('recipe')})",

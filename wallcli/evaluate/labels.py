@@ -8,8 +8,8 @@ of its ``activities`` other than ``none`` (what tests/test_examples.py checks th
 against). A labels.csv that cannot be read is a failure of the whole run (exit 1, naming the line);
 a clip that is missing is not: it becomes that clip's error row. A sidecar is one clip's labels, so
 a damaged one (beside its video) skips that clip, with the reason, rather than failing the run.
-Two names for one file (``a.mp4``, ``./a.mp4``) are one clip listed twice: an error, as any
-duplicate is, since scoring it twice would weigh it double.
+Two names for one file (``a.mp4``, ``./a.mp4``, a hard link or symlink to it) are one clip listed
+twice: an error, as any duplicate is, since scoring it twice would weigh it double.
 """
 from __future__ import annotations
 
@@ -22,9 +22,13 @@ from pathlib import Path
 from typing import Any
 
 from wallcli.errors import WallcliError
+from wallcli.io import jsonfile
 
 LABELS = "labels.csv"
 REQUIRED = ("file", "people", "activity")
+# A row is a file name and a few numbers; a longer line is not labels, and is refused before it is
+# read whole (a 1 GB line once took 2 GB of memory before the csv module gave up on it).
+MAX_LINE = 64 * 1024
 
 
 @dataclass(frozen=True)
@@ -72,22 +76,30 @@ def read_labels(folder: str | Path) -> Labels:
 
 
 def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
-    """Fail on two entries that name one file, however spelled (``a.mp4``, ``./a.mp4``, its full path)."""
-    seen: dict[str, tuple[str, Clip]] = {}
+    """Fail on two entries that name one file, however spelled (``a.mp4``, ``./a.mp4``, its full
+    path) or reached (a hard link or symlink): by its spelling, and by device and inode if it exists
+    (``sub/../a.mp4`` names a.mp4 even where no ``sub`` exists, so both are looked at)."""
+    seen: dict[Any, tuple[str, Clip]] = {}
     for where, c in named:
-        key = os.path.normcase(os.path.normpath(os.path.abspath(c.path)))
-        if key in seen:
-            first, other = seen[key]
-            raise WallcliError(f"{source} names one clip twice: {first} ({other.file!r}) and {where} ({c.file!r}); "
-                               "list each clip once")
-        seen[key] = (where, c)
+        keys: list[Any] = [os.path.normcase(os.path.normpath(os.path.abspath(c.path)))]
+        try:
+            st = os.stat(c.path)
+            keys.append((st.st_dev, st.st_ino))
+        except (OSError, ValueError):  # missing (its row's error later) or an unusable name
+            pass
+        for key in keys:
+            if key in seen:
+                first, other = seen[key]
+                raise WallcliError(f"{source} names one clip twice: {first} ({other.file!r}) and {where} "
+                                   f"({c.file!r}); list each clip once")
+        seen.update((key, (where, c)) for key in keys)
 
 
 def _from_csv(d: Path) -> tuple[list[Clip], bool]:
     path = d / LABELS
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
-            reader = csv.DictReader(f)
+            reader = csv.DictReader(_bounded_lines(f, path))
             header = [h.strip() for h in reader.fieldnames or []]
             missing = [c for c in REQUIRED if c not in header]
             if missing:
@@ -97,12 +109,22 @@ def _from_csv(d: Path) -> tuple[list[Clip], bool]:
             has_snr = "snr_db" in header
             named = [(f"line {n}", _csv_row(path, n, row, has_snr)) for n, row in enumerate(reader, start=2)
                      if any((v or "").strip() for v in row.values() if isinstance(v, str))]
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+    except csv.Error as exc:  # e.g. a quoted cell that runs over many lines
+        raise WallcliError(f"cannot read {path} line {reader.line_num}: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
         raise WallcliError(f"cannot read {path}: {exc}") from None
     if not named:
         raise WallcliError(f"{path} lists no clips")
     _no_duplicates(path, named)
     return [c for _, c in named], has_snr
+
+
+def _bounded_lines(f, path: Path):
+    for n, line in enumerate(iter(lambda: f.readline(MAX_LINE + 1), ""), start=1):
+        if len(line) > MAX_LINE:
+            raise WallcliError(f"{path} line {n} is longer than {MAX_LINE} characters; labels.csv holds "
+                               "one short row per clip")
+        yield line
 
 
 def _csv_row(path: Path, line: int, row: dict, has_snr: bool) -> Clip:
@@ -168,7 +190,7 @@ def _from_sidecars(d: Path) -> tuple[list[Clip], list[tuple[str, str]]]:
 
 def _sidecar(d: Path, side: Path, beside: list[Path]) -> Clip:
     """The clip a sidecar labels; LookupError: not a sidecar at all."""
-    meta = json.loads(side.read_text(encoding="utf-8"))
+    meta = jsonfile.loads(side.read_text(encoding="utf-8"), allow_nan=True)
     keys = [k for k in ("people", "activity") if isinstance(meta, dict) and k in meta]
     if not keys:
         raise LookupError(side.name)

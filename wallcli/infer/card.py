@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from wallcli.errors import WallcliError
+from wallcli.io import jsonfile
 from wallcli.signal.window import NORMALIZATION, NORMALIZATION_TEXT
 
 CARD_FORMAT = "wallcli.model-card"
@@ -72,18 +73,11 @@ def read_card(model_path: Path) -> dict[str, Any]:
     try:
         if path.stat().st_size > MAX_CARD_BYTES:
             raise WallcliError(f"model card {path} is {path.stat().st_size} bytes; a card is a small JSON file")
-        card = json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_constant)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, ValueError) as e:
+        card = jsonfile.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
         raise WallcliError(f"model card {path} is not valid JSON: {e}") from None
-    except RecursionError:
-        raise WallcliError(f"model card {path} is not valid JSON: nested too deeply") from None
     validate_card(card, path)
     return card
-
-
-def _no_constant(name: str):
-    # Python's json reads NaN and Infinity, which JSON does not have
-    raise ValueError(f"{name} is not a JSON number")
 
 
 def _is_number(x: Any) -> bool:

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from wallcli.errors import WallcliError
+from wallcli.io import jsonfile
 from wallcli.io.writer import atomic_path
 
 META_KEY = "meta"
@@ -25,10 +26,6 @@ def save_npz(path: str | os.PathLike, arrays: dict[str, np.ndarray], meta: dict,
     with atomic_path(path, force=force) as tmp:
         with open(tmp, "wb") as fh:
             np.savez(fh, **payload)
-
-
-def _no_constant(name: str):
-    raise ValueError(f"{name} is not a JSON number")
 
 
 def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[str, np.ndarray], dict]:
@@ -59,8 +56,8 @@ def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[
     if meta_arr.shape != () or meta_arr.dtype.kind != "U":
         raise WallcliError(f"{p} has corrupt metadata (not a JSON string)")
     try:
-        meta = json.loads(str(meta_arr[()]), parse_constant=_no_constant)
-    except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError
+        meta = jsonfile.loads(str(meta_arr[()]))
+    except ValueError as exc:  # JSONDecodeError is a ValueError
         raise WallcliError(f"{p} has corrupt metadata: {exc}") from None
     if not isinstance(meta, dict):
         raise WallcliError(f"{p} has corrupt metadata (not a JSON object)")

@@ -66,6 +66,7 @@ class VideoInfo:
     duration: float | None
     codec: str = ""  # FFmpeg's decoder name, e.g. 'h264' (for reports of the evidence)
     container: str = ""  # FFmpeg's demuxer name, e.g. 'mov,mp4,m4a,3gp,3g2,mj2'
+    fps_source: str = "container"  # where fps came from: 'container', 'codec' (its headers) or 'assumed'
 
 
 @dataclass
@@ -83,6 +84,13 @@ class Frame:
 GAP_FACTOR = 5.0
 GAP_MIN = 0.25
 GAP_HISTORY = 16  # recent intervals whose median is the typical one
+
+# FFmpeg's demuxers of bare elementary streams: no timestamps, and an average_rate that is only
+# the demuxer's -framerate default (25), whatever the frames are; the codec's headers (H.264's
+# VUI timing, MPEG-2's sequence header) are what knows the rate
+RAW_DEMUXERS = frozenset({"h264", "hevc", "vvc", "m4v", "mpegvideo", "cavsvideo", "avs2", "avs3", "vc1", "dirac",
+                          "mjpeg", "dnxhd"})
+RAW_DEFAULT_FPS = 25  # what FFmpeg assumes for such a stream that states no rate
 
 
 def _real_video(stream) -> bool:
@@ -136,7 +144,9 @@ class VideoReader:
                 raise WallcliError(f"no such file: {source}")
             if p.is_dir():
                 raise WallcliError(f"{source} is a folder, not a video")
-            if p.stat().st_size == 0:
+            # only a regular file's size means anything: a FIFO, <(...), /dev/stdin or a device
+            # reports 0 and is read as a stream
+            if p.is_file() and p.stat().st_size == 0:
                 raise WallcliError(f"{source} is empty (0 bytes)")
         try:
             self._container = av.open(target, mode="r", format=fmt, options=options, timeout=30.0)
@@ -153,15 +163,29 @@ class VideoReader:
         stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
         stream.codec_context.thread_count = int(threads)
         self._stream = stream
-        rate = stream.average_rate or stream.guessed_rate or stream.base_rate
+        fps_source = "container"
+        container_name = str(self._container.format.name or "")
+        raw = container_name in RAW_DEMUXERS
+        rate = None if raw else stream.average_rate
+        if raw:
+            stated = stream.codec_context.framerate
+            if stated and stated > 0:
+                rate, fps_source = stated, "codec"
+                self.warnings.append(f"{source}: a bare {container_name} stream has no timestamps; read at "
+                                     f"{float(stated):.4g} fps, the rate its codec headers state")
+            else:
+                rate, fps_source = Fraction(RAW_DEFAULT_FPS), "assumed"
+                self._warn(f"{source}: a bare {container_name} stream states no frame rate; assuming "
+                           f"{RAW_DEFAULT_FPS} fps (FFmpeg's default): times and rates are wrong if it is not")
+        rate = rate or stream.guessed_rate or stream.base_rate
         if not rate or rate <= 0:
-            rate = Fraction(30)
+            rate, fps_source = Fraction(30), "assumed"
             self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
         fps = Fraction(rate).limit_denominator(1001)
         try:
-            # the measured rate only: a container that gives none leaves FFmpeg guessing from its time
-            # base (Matroska's 1000), which says nothing of the frames
-            if stream.average_rate:
+            # the measured or stated rate only: a container that gives none leaves FFmpeg guessing
+            # from its time base (Matroska's 1000), which says nothing of the frames
+            if stream.average_rate or fps_source == "codec":
                 check_rate(fps, source)
         except WallcliError:
             self._container.close()
@@ -185,7 +209,8 @@ class VideoReader:
             pix_fmt=str(cc.pix_fmt or ""),
             duration=duration,
             codec=str(cc.name or ""),
-            container=str(self._container.format.name or ""),
+            container=container_name,
+            fps_source=fps_source,
         )
         self.rotation = 0  # quarter turns (np.rot90's k) applied to every frame: its display matrix
         self._rotation_noted = False
@@ -298,6 +323,7 @@ class VideoReader:
 
         recent: deque = deque(maxlen=GAP_HISTORY)
         self.gaps = []
+        size = None  # (width, height) of the first frame: every analysis holds per-pixel state of that size
         try:
             while True:
                 kind, item = q.get()
@@ -322,7 +348,12 @@ class VideoReader:
                         else:
                             recent.append(dt)
                     last_time = t
-                    yield Frame(index, t, self._turn(frame, frame_planes(frame)), frame, gap)
+                    planes = self._turn(frame, frame_planes(frame))
+                    if size is None:
+                        size = (planes.width, planes.height)
+                    elif (planes.width, planes.height) != size:
+                        raise self._size_changed(index, t, size, (planes.width, planes.height))
+                    yield Frame(index, t, planes, frame, gap)
                     index += 1
                 elif kind == "damage":
                     if index == 0 and self._mp4_on_a_pipe():
@@ -345,6 +376,13 @@ class VideoReader:
             self._stop_worker()
         if index == 0:
             raise WallcliError(f"{self.source}: no frames could be decoded")
+
+    def _size_changed(self, index: int, t: float, old: tuple[int, int], new: tuple[int, int]) -> WallcliError:
+        """One line for every command: the block grids, plots and frames written so far all have the
+        first size, and no analysis spans two views of a wall."""
+        return WallcliError(f"{self.source}: the frame size changes from {old[0]}x{old[1]} to {new[0]}x{new[1]} at "
+                            f"frame {index} ({t:.2f} s); wallcli analyses a video of one frame size",
+                            hint=f"cut it there and analyse each part, e.g. ffmpeg -i IN -t {t:.2f} -c copy part1.ts")
 
     def _mp4_on_a_pipe(self) -> bool:
         """An MP4 (or MOV) read from stdin: its index usually sits at the end of the file, where a

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from wallcli.errors import WallcliError
+from wallcli.io import jsonfile
 from wallcli.report.verdicts import answer
 
 TASKS = ("count", "activity")
@@ -39,7 +40,7 @@ def read_results(path: str | Path) -> tuple[list[dict[str, Any]], list[str]]:
         if not line.strip():
             continue
         try:
-            rec = json.loads(line)
+            rec = jsonfile.loads(line, allow_nan=True)
         except json.JSONDecodeError as exc:
             rec = None
             why = f"line {n} is not JSON ({exc.msg}); a scan stopped while writing it?"

@@ -16,6 +16,7 @@ import numpy as np
 from wallcli.errors import WallcliError
 
 Roi = tuple[int, int, int, int]
+MIN_ROI = 2  # pixels on each side of a requested ROI
 
 
 def check_roi(roi: Roi | None, width: int, height: int) -> Roi:
@@ -25,6 +26,9 @@ def check_roi(roi: Roi | None, width: int, height: int) -> Roi:
     x, y, w, h = (int(v) for v in roi)
     if w <= 0 or h <= 0:
         raise WallcliError(f"ROI {x},{y},{w},{h} is empty; the frame is {width}x{height}")
+    if w < MIN_ROI or h < MIN_ROI:  # one rule for every command (snr needs a whole chroma sample)
+        raise WallcliError(f"ROI {x},{y},{w},{h} is smaller than {MIN_ROI}x{MIN_ROI} pixels (one chroma sample of "
+                           f"4:2:0 video); the frame is {width}x{height}")
     if x < 0 or y < 0 or x + w > width or y + h > height:
         raise WallcliError(f"ROI {x},{y},{w},{h} is outside the {width}x{height} frame "
                            f"(x+w must be <= {width}, y+h <= {height})")

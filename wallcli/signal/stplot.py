@@ -152,6 +152,7 @@ def compute_stplot(
         "frame_size": frame_size,
         "fps": float(info.fps),
         "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}",
+        "fps_source": getattr(info, "fps_source", "container"),
         "frames": times.n,
         "roi": list(roi),
         "bins": int(bins),

@@ -26,7 +26,7 @@ from wallcli.signal.view_image import (
 from wallcli.signal.view_light import _chroma, _objects, _relative_texture
 from wallcli.signal.view_limits import (
     CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
-    MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
+    MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_REGISTER_SIDE, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
     REL, REL_EDGE,
     SHARP, SIGMA_FLOOR, TEX_TAU,
 )
@@ -245,6 +245,10 @@ class ViewCheck:
             # to register on (OpenCV's window needs two): its motion cannot be judged, so say so
             flags.add("too thin to check")
             dx = dy = 0.0
+        elif min(hp.shape) < MIN_REGISTER_SIDE:
+            # no structure to register a shift on: a pan would pass as still, so say it was not checked
+            flags.add("too small to check")
+            dx = dy = 0.0
         else:
             if self._window is None or self._window.shape != hp.shape:
                 self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
@@ -254,7 +258,7 @@ class ViewCheck:
         moved = False
         # a shift of half the floor that fits is not motion yet, but a shake on its way to it:
         # every frame is then checked (see CHECK_RATE), as the old every-frame check did
-        if shift >= MIN_SHIFT / 2 and min(hp.shape) > 32:  # smaller: no structure to register on
+        if shift >= MIN_SHIFT / 2 and min(hp.shape) >= MIN_REGISTER_SIDE:
             fits = _shift_fits(self._ref_h, hp, dx, dy, var_h)
             # and it must hold from one frame to the next: a camera moves smoothly, while the
             # correlation peaks of noise land anywhere
@@ -389,8 +393,10 @@ class ViewCheck:
             return {"usable": False, "issues": ["too little usable area"], "reason": "no frame was checked", "notes": []}
         reason = None
         if refused:
-            parts = [f"{k} at {_spans_text(found[k])}" for k in refused if k != "frame gap"]
+            unchecked = ("too thin to check", "too small to check")  # what the check could not do
+            parts = [f"{k} at {_spans_text(found[k])}" for k in refused if k != "frame gap" and k not in unchecked]
             reason = "; ".join((["not a static view of the wall: " + "; ".join(parts)] if parts else [])
+                               + [KINDS[k] for k in refused if k in unchecked]
                                + ([f"frames missing at {_spans_text(found['frame gap'])}"]
                                   if "frame gap" in refused else []))
         notes = [f"{NOTES[k]} (at {_spans_text(s)})" for k, spans in self.note_spans.items()
