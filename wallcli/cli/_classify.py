@@ -64,6 +64,8 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     reads = [input, model_path or shipped_model_path(task)]
     if task == "count" and not single_stage:
         reads.append(activity_model or shipped_model_path("activity"))
+    if task == "activity":  # its answers are checked by the count net for two people
+        reads.append(shipped_model_path("count"))
     check_outputs([plot], force=force, inputs=reads)
     model = load_classifier(task, model_path, threads=threads, activity_path=activity_model, single=single_stage)
     stride = int(stride or model.card["stride"])

@@ -61,19 +61,34 @@ def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None
     return confident, reason
 
 
+def _gate(model, raw, probs, confident: bool, reason):
+    """An activity answer where two people may be moving is not decided, whatever the net says
+    (:class:`wallcli.infer.twostage.OnePersonActivity`); its reason replaces the model's."""
+    if not hasattr(model, "gate"):
+        return confident, reason
+    why = model.gate(raw, model.classes[int(np.argmax(probs))])[1]
+    return (False, why) if why else (confident, reason)
+
+
+def _round(x):
+    return None if x is None else round(float(x), 6)
+
+
 def _window_record(model, start: float, raw: np.ndarray, signal_db: float) -> dict[str, Any]:
     """One window's answer from the model's raw output for it (for a two-stage count, both nets')."""
     probs = model.combine(raw)[0]
     k = int(np.argmax(probs))
     # judged on the figure the JSON carries, so that the reason quotes exactly that figure
     signal_db = round(float(signal_db), 2)
-    confident, reason = _judge(model, probs, signal_db)
+    confident, reason = _gate(model, raw, probs, *_judge(model, probs, signal_db))
     rec = {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
            "label": model.classes[k], "probabilities": [float(p) for p in probs],
            "confident": confident, "reason": reason, "signal_db": signal_db}
     stages = model.stages(raw)
     if stages is not None:
         rec["stages"] = stages
+    if hasattr(model, "gate"):
+        rec["two_people"] = _round(model.gate(raw, rec["label"])[0])
     return rec
 
 
@@ -97,7 +112,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str, found=N
     clip = model.combine(raw)[0]
     clip = clip / clip.sum()
     clip_db = round(float(np.mean(signal_db)), 2)
-    confident, reason = _judge(model, clip, clip_db)
+    confident, reason = _gate(model, raw, clip, *_judge(model, clip, clip_db))
     out = {
         "input": source,
         "task": model.task,
@@ -115,6 +130,8 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str, found=N
         "windows": [_window_record(model, t, pr, db) | {"corrections": corr.merge([f])}
                     for t, pr, db, f in zip(times, probs, signal_db, found)],
     }
+    if hasattr(model, "gate"):  # activity: how likely two people are, from the count net
+        out["two_people"] = _round(model.gate(raw, out["label"])[0])
     if model.stages(raw) is not None:  # a two-stage count: what each stage found for the clip
         from wallcli.infer.twostage import stages_info
 
