@@ -48,3 +48,30 @@ def answer_text(result: dict) -> str:
     if result.get("confident", True):
         return f"{result['label']} (p={p:.2f})"
     return f"undetermined (most likely {result['label']}, p={p:.2f})"
+
+
+# -- the trust rule, worded once: every reason, note and page takes its figure from the card's
+# confidence level (``level``), so the figure follows whatever card ships
+
+def level_text(level) -> str:
+    """A card's confidence level as a figure: 0.97 -> '97 %', 0.975 -> '97.5 %'."""
+    return f"{float(level) * 100:.1f}".rstrip("0").rstrip(".") + " %"
+
+
+def not_often_enough(what: str, signal_db, level, band: str) -> str:
+    """Why an answer whose cell of the card has no threshold is not decided."""
+    return (f"'{what}' at signal {format_db(signal_db)} dB: answers like this were not right often enough in "
+            f"validation to be relied on ({level_text(level)} needed; {band})")
+
+
+def under_threshold(p: float, what: str, signal_db, level, t: float) -> str:
+    """Why an answer under its cell's threshold is not decided."""
+    return (f"p={p:.3f} for '{what}' at signal {format_db(signal_db)} dB: answers like this were right "
+            f"{level_text(level)} of the time in validation only from p={t:.3f}")
+
+
+def decided_text(level) -> str:
+    """What a decided answer means, in words (tables, pages)."""
+    if level is None:
+        return "decided"
+    return f"decided: answers like this were right at least {level_text(level)} of the time in validation"

@@ -143,9 +143,9 @@ def test_the_headline_says_each_undetermined_answer_in_plain_words():
     block = {"level": 0.97, "signal_edges_db": [0.0], "thresholds": [[None, None, None], [0.9, None, 0.95]]}
     cases = {
         "nobody moving is never decided": ([0.99, 0.005, 0.005], 5.0),
-        "'1 person' answers were never right 97% of the time in validation at a signal like this one (4.7 dB)":
-            ([0.2, 0.7, 0.1], 4.7),
-        "its probability (0.80) is under the 0.95 from which '2 people' answers were right 97%": ([0.1, 0.1, 0.8], 3.0),
+        "'1 person' answers at a signal like this one (4.7 dB) were not right often enough in validation to be "
+        "relied on (97 % needed)": ([0.2, 0.7, 0.1], 4.7),
+        "its probability (0.80) is under the 0.95 from which '2 people' answers were right 97 %": ([0.1, 0.1, 0.8], 3.0),
     }
     for words, (probs, snr) in cases.items():
         ok, reason = judge(block, probs, snr, [0, 1, 2])
