@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import math
 
+# What count counts, said the same way in the README, `count --help` and every simulated clip's
+# truth file (whose 'people' counts everyone in the room)
+COUNT_COUNTS = "count counts the people who move: a person standing still counts 0"
+
 
 def format_db(x) -> str:
     """``x`` dB as text: '12.3', '0.0' (for -0.04 too), '-' when there is no finite number."""

@@ -30,6 +30,9 @@ def count(
 ) -> None:
     """Count the people (0, 1 or 2) moving out of view, from the light on a blank wall.
 
+    count counts the people who move: a person standing still counts 0 (a still person's
+    sway can still show on a strong signal, and is then counted; see the README).
+
     The space-time plots are cut into 256-frame windows (8.5 s at 30 fps, any input frame
     rate is resampled). Two stages answer: is anybody moving (the count net, which reads the
     horizontal plot as the paper's does, and the activity net, which reads both plots, as two
