@@ -378,7 +378,9 @@ def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64,
 
 def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
            corrections: corr.Options = corr.Options()) -> Iterator[dict[str, Any]]:
-    """One result per window, yielded as soon as its last frame is decoded.
+    """One result per window, yielded as soon as its last frame is decoded; when the input ends
+    (a file, a stream that closes), the end-aligned last window, then the clip's result (the
+    object of :func:`classify_video`, with ``windows``): the same windows as the whole run.
 
     Rows are raw (not clip-mean-removed): ``normalize_window`` removes each window's own
     mean, so no clip mean, which a live stream does not have, is needed.
@@ -389,22 +391,30 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
-    windower = StreamWindower(model.window, stride)
+    # the classifier of classify_video, so that the lines are its windows (and its clip answer)
+    classifier = WindowClassifier(model, stride, corrections=corrections)
     check = ViewCheck(roi)
     blend = TemporalNoise()
     with open_video(source, threads=threads) as reader:
+        classifier.native_fps = float(reader.info.fps)
         # cleaned as in classify_video (a line lists no corrections of the clip's)
         unique = CameraPipeline(reader, check)
         rows = RowStream(FrameTee(unique, (check, blend)), roi=roi, bins=model.bins, fps=model.fps,
                          vertical="vertical" in model.input_names or corrections.light, register=corrections.shake)
         for t, row in rows:
-            done = windower.push(t, stream_row(row, rows))
-            if done is not None:
-                p, db, found = _predict_window(model, done[2], rows.ref, start=done[0], native=float(reader.info.fps),
-                                               options=corrections)
-                rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
+            n = len(classifier.times)
+            classifier.push(t, stream_row(row, rows), rows.ref)
+            if len(classifier.times) > n:
+                rec = _window_record(model, classifier.times[-1], classifier.probs[-1], classifier.signal[-1])
+                rec |= {"corrections": corr.merge([classifier.found[-1]])}
                 # what the frames so far say of the noise (a window holds 256 of them)
                 yield bound_result(judge_view(rec, check.view(rec["start"], rec["end"])), blend.correction())
-        if windower.count < model.window:
+        if classifier.windower.last() is None:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)
+    result = with_view(classifier.result(str(source), frames=unique.decoded), check)
+    result["corrections"] += unique.corrections()
+    result = bound_result(result, blend.correction())
+    if len(result["windows"]) > len(classifier.times):  # the end-aligned last window
+        yield result["windows"][-1]
+    yield result
