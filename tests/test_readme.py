@@ -52,11 +52,17 @@ def test_links_lead_somewhere():
             assert (doc.parent / target).exists(), f"{doc.name}: {target}"
 
 
-def test_the_suites_wall_time_is_stated_and_within_ten_minutes():
+def test_the_suites_figures_agree_and_the_split_is_explicit():
+    """The quick start and the development section state the same size, time and install of the
+    suite, and the split is a command a reader can copy (`-m 'not slow'`)."""
+    quick = README.split("## Quick start", 1)[1].split("\n## ", 1)[0]
     dev = README.split("## Development", 1)[1].split("\n## ", 1)[0]
-    minutes = re.search(r"takes about (\d+) minutes", dev)
-    assert minutes and int(minutes.group(1)) <= 10
-    assert "-m slow" in dev or "not slow" in dev  # the split is explained
+    tests = re.search(r"≈ (\d+) tests", quick).group(1)
+    minutes = re.search(r"~(\d+) min in CI", quick).group(1)
+    gb = re.search(r"(\d+\.\d) GB", quick).group(1)
+    flat = " ".join(dev.split())
+    assert f"about {tests} tests" in flat and f"about {minutes} minutes" in flat and f"about {gb} GB" in flat
+    assert "bash tests/run.sh -m 'not slow'" in dev and "bash tests/run.sh -m slow" in dev
 
 
 def _pipeline_lines() -> list[str]:
