@@ -205,9 +205,6 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         refuse_view(input, result["view"])
     res = acc.result()
     notes = result["warnings"]
-    from wallcli.signal.snr_verdict import snr_verdict
-
-    result["verdict"] = snr_verdict(result)
     if auto:
         result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
                           "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0)),
