@@ -103,3 +103,24 @@ def test_every_example_is_a_usable_view(clip):
     view = vc.summary()
     assert view["usable"], view
     assert view["issues"] == [], view
+
+
+def test_pipeline_sh_prints_count_and_activity_the_same_way(tmp_path, run_cli):
+    # examples/pipeline.sh printed count as one long JSON line and activity as a table
+    import shlex
+
+    script = (EXAMPLES / "pipeline.sh").read_text()
+    lines = {t: [ln for ln in script.splitlines() if ln.startswith(f"$w {t} ")] for t in ("stplot", "count", "activity")}
+    assert all(len(v) == 1 for v in lines.values()), lines
+    clip, out = str(EXAMPLES / "walking.mp4"), str(tmp_path)
+    shown = {}
+    for task, (line,) in lines.items():
+        args = shlex.split(line.replace('"$clip"', shlex.quote(clip)).replace('$out', out))[1:]
+        code, stdout, err = run_cli(*args)
+        assert code == 0, err
+        shown[task] = stdout
+    for task in ("count", "activity"):
+        assert "--json" not in lines[task][0] and "jq" not in lines[task][0]
+        title, header, rule, *_ = shown[task].splitlines()
+        assert f": {task} = " in title and header.startswith("start (s)  answer") and set(rule) == {"─"}
+        assert not shown[task].lstrip().startswith("{")

@@ -46,12 +46,17 @@ def label_text(label) -> str:
 
 
 def answer_text(result: dict) -> str:
-    """A clip's answer as a title states it: '1 (p=0.93)', or 'undetermined (most likely 1, p=0.75)'
-    when it may not be relied upon; the same words under a table and over a figure."""
+    """A clip's answer as a title states it, in words: '1 person (decided, p=0.97)', or
+    'undetermined (most likely 1 person, p=0.75)' when it may not be relied upon; the same words
+    over a table and over a figure. A title starts with the answer ('count = 1'), for grep."""
     p = max(result["probabilities"])
-    if result.get("confident", True):
-        return f"{result['label']} (p={p:.2f})"
-    return f"undetermined (most likely {result['label']}, p={p:.2f})"
+    said = label_text(result["label"])
+    confident = result.get("confident")
+    if confident is None:  # a result that was never judged: no claim either way
+        return f"{said} (p={p:.2f})"
+    if confident:
+        return f"{said} (decided, p={p:.2f})"
+    return f"undetermined (most likely {said}, p={p:.2f})"
 
 
 # -- the trust rule, worded once: every reason, note and page takes its figure from the card's
