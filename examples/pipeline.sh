@@ -20,8 +20,10 @@ echo "== signal and noise ($clip)" >&2
 $w snr "$clip"
 echo "== space-time plots -> $out/plots.npz, $out/plots.png" >&2
 $w stplot "$clip" -o "$out/plots.npz" --png "$out/plots.png" --force
+# count and activity print the same way: a table titled with the answer, and one line saying
+# why it is decided or not (-v adds the models' validated accuracy; --json gives the data)
 echo "== how many people (from the plots)" >&2
-$w count "$out/plots.npz" --json
+$w count "$out/plots.npz"
 echo "== what they are doing" >&2
 $w activity "$clip"
 echo "== amplified video -> $out/amplified.mp4" >&2

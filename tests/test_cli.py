@@ -101,3 +101,23 @@ def test_too_short_quotes_the_files_own_frames(tmp_path, run_cli, n, fps):
     if code == 0:
         code, _, err = run_cli("count", tmp_path / "p.npz")
         assert code == 1 and f"{n} frame(s) decoded" in err, err
+
+
+def test_follow_on_a_file_gives_the_whole_runs_windows_and_ends_with_the_clip(run_cli):
+    """--follow on a finite file: the windows of the whole run (the end-aligned last one too),
+    then the clip's answer, the object --json prints."""
+    import json
+    from pathlib import Path
+
+    clip = Path(__file__).resolve().parents[1] / "examples" / "walking.mp4"
+    code, out, _ = run_cli("activity", clip, "--json")
+    whole = json.loads(out)
+    code2, out, _ = run_cli("activity", clip, "--follow")
+    lines = [json.loads(x) for x in out.splitlines()]
+    assert code == code2 == 0 and len(whole["windows"]) == 3
+    *windows, last = lines
+    assert [w["start"] for w in windows] == [w["start"] for w in whole["windows"]]
+    assert [w["probabilities"] for w in windows] == [w["probabilities"] for w in whole["windows"]]
+    assert "windows" in last and not any("windows" in w for w in windows)
+    assert {k: last[k] for k in ("label", "probabilities", "confident", "reason", "signal_db")} == \
+        {k: whole[k] for k in ("label", "probabilities", "confident", "reason", "signal_db")}

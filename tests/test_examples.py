@@ -19,7 +19,7 @@ CLIPS = sorted(EXAMPLES.glob("*.mp4"))
 
 # (task, clip) -> what the shipped model says instead of the truth
 KNOWN_WRONG = {
-    ("count", "standing"): "count 0.4.1 says 1 (the still person's sway shows in the plot; see the README)",
+    ("count", "standing"): "count 0.4.1 says 1 (the still person's sway shows in the plot; README, 'What count counts')",
     ("count", "two-mixed"): "count 0.4.1 says 1",
     # the two-stage count's prior odds of two people against one (1:4, the share of two-person rooms
     # in the footage the models are validated for) outweigh the count net's 0.73 for two here
@@ -44,8 +44,8 @@ def cases(task: str, clips: list[Path]) -> list:
 def test_count_on_examples(clip, run_cli):
     code, out, err = run_cli("count", clip, "--json")
     assert code == 0, err
-    moving = sum(a != "none" for a in truth(clip)["activities"])
-    assert json.loads(out)["label"] == moving
+    assert truth(clip)["moving"] == sum(a != "none" for a in truth(clip)["activities"])
+    assert json.loads(out)["label"] == truth(clip)["moving"]
 
 
 @pytest.mark.parametrize("clip", cases("activity", [c for c in CLIPS if truth(c)["people"] <= 1]))
@@ -53,6 +53,20 @@ def test_activity_on_examples(clip, run_cli):
     code, out, err = run_cli("activity", clip, "--json")
     assert code == 0, err
     assert json.loads(out)["label"] == truth(clip)["activity"]
+
+
+def test_what_count_counts_reads_the_same_everywhere(run_cli):
+    """The README, `count --help` and every truth file say what count counts in the same words;
+    standing.mp4, the expected failure that points to the README, is named there."""
+    from wallcli.wording import COUNT_COUNTS
+
+    readme = " ".join((EXAMPLES.parent / "README.md").read_text(encoding="utf-8").split())
+    assert COUNT_COUNTS in readme and "examples/standing.mp4" in readme and "What count counts" in readme
+    code, out, _ = run_cli("count", "--help")
+    assert code == 0 and COUNT_COUNTS in " ".join(out.replace("│", " ").split())
+    for clip in CLIPS:
+        assert truth(clip)["moving_note"] == COUNT_COUNTS
+    assert truth(EXAMPLES / "standing.mp4")["people"] == 1 and truth(EXAMPLES / "standing.mp4")["moving"] == 0
 
 
 def test_known_wrong_names_real_clips():
@@ -89,3 +103,24 @@ def test_every_example_is_a_usable_view(clip):
     view = vc.summary()
     assert view["usable"], view
     assert view["issues"] == [], view
+
+
+def test_pipeline_sh_prints_count_and_activity_the_same_way(tmp_path, run_cli):
+    # examples/pipeline.sh printed count as one long JSON line and activity as a table
+    import shlex
+
+    script = (EXAMPLES / "pipeline.sh").read_text()
+    lines = {t: [ln for ln in script.splitlines() if ln.startswith(f"$w {t} ")] for t in ("stplot", "count", "activity")}
+    assert all(len(v) == 1 for v in lines.values()), lines
+    clip, out = str(EXAMPLES / "walking.mp4"), str(tmp_path)
+    shown = {}
+    for task, (line,) in lines.items():
+        args = shlex.split(line.replace('"$clip"', shlex.quote(clip)).replace('$out', out))[1:]
+        code, stdout, err = run_cli(*args)
+        assert code == 0, err
+        shown[task] = stdout
+    for task in ("count", "activity"):
+        assert "--json" not in lines[task][0] and "jq" not in lines[task][0]
+        title, header, rule, *_ = shown[task].splitlines()
+        assert f": {task} = " in title and header.startswith("start (s)  answer") and set(rule) == {"─"}
+        assert not shown[task].lstrip().startswith("{")

@@ -63,7 +63,7 @@ def test_shipped_cards_carry_the_measured_accuracy_and_the_table_says_it(task, g
     assert tr["scored"] == sum(map(sum, tr["confusion"])) and tr["ci95"][0] <= tr["accuracy"] <= tr["ci95"][1]
     assert 0 <= tr["coverage"] <= 1 and tr["decided"] == round(tr["coverage"] * tr["scored"])
     assert card["confidence"]["calibrated_on"]["windows"] > 0
-    code, out, err = run_cli(task, golden_clip)
+    code, out, err = run_cli(task, golden_clip, "-v")  # the card's figures, for a reader who asks
     assert code == 0, err
     said = " ".join(err.split())  # the note is wrapped to the terminal's width
     assert f"right on {tr['accuracy']:.0%} (95 % CI {tr['ci95'][0]:.0%}" in said and "independent renderer" in said

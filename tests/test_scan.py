@@ -316,3 +316,18 @@ def test_watchdog_gives_up_on_a_stalled_task_not_on_a_slow_one():
     with pytest.raises(ValueError):
         run_with_watchdog(lambda beat: int("x"), timeout=5)
     never.set()
+
+
+def test_scans_snr_object_is_snr_json_verdict_included(tmp_path, run_cli):
+    # scan --help: the answers equal those of 'wallcli snr --json'; one function builds both
+    clip = Path(__file__).resolve().parents[1] / "examples" / "two-mixed.mp4"
+    out = tmp_path / "day.jsonl"
+    code, _, err = run_cli("scan", clip, "-o", out, "--task", "snr", "--workers", "1")
+    assert code == 0, err
+    (line,) = _lines(out)
+    code, stdout, err = run_cli("snr", clip, "--json")
+    assert code == 0, err
+    want = json.loads(stdout)
+    assert line["snr"]["verdict"] == want["verdict"]
+    assert set(want["verdict"]) == {"signal", "block", "snr_db", "text", "why"}
+    assert sorted(line["snr"]) == sorted(want)

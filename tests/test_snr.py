@@ -345,3 +345,21 @@ def test_lattice_tiles_stay_on_whole_chroma_samples():
     off = planes.to_rgb(np.zeros(1), np.zeros(1), np.zeros(1))[0]  # _rgb drops the affine offset
     assert np.abs(got + off[:, None, None, None, None] - want).max() < 0.05  # float32 rounding only
 
+
+
+def test_predict_names_the_unit_of_every_quantity(run_cli):
+    import json
+
+    code, out, _ = run_cli("snr", "--predict", "--distance", "2", "--mean-code", "128", "--gain", "4")
+    rows = {line.split()[0]: line for line in out.splitlines()[3:] if line.strip()}
+    assert code == 0 and "unit" in out
+    assert "code values²" in rows["signal_power"] and "code values" in rows["amplitude"] and "dB" in rows["snr_db"]
+    assert "fraction" in rows["theta"]
+    code, out, _ = run_cli("snr", "--predict", "--distance", "2", "--json")
+    got = json.loads(out)
+    assert got["units"] == {"theta": "fraction of view blocked", "amplitude": "code values",
+                            "signal_power": "code values²"}
+    code, out, _ = run_cli("snr", "--predict", "--distance", "2", "--sweep", "distance=1:2:1", "--mean-code", "128",
+                           "--gain", "4")
+    flat = " ".join(out.split())
+    assert code == 0 and "amplitude (cv)" in flat and "(cv²)" in flat and "code values of an 8-bit video" in flat

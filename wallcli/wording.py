@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import math
 
+# What count counts, said the same way in the README, `count --help` and every simulated clip's
+# truth file (whose 'people' counts everyone in the room)
+COUNT_COUNTS = "count counts the people who move: a person standing still counts 0"
+
 
 def format_db(x) -> str:
     """``x`` dB as text: '12.3', '0.0' (for -0.04 too), '-' when there is no finite number."""
@@ -42,9 +46,41 @@ def label_text(label) -> str:
 
 
 def answer_text(result: dict) -> str:
-    """A clip's answer as a title states it: '1 (p=0.93)', or 'undetermined (most likely 1, p=0.75)'
-    when it may not be relied upon; the same words under a table and over a figure."""
+    """A clip's answer as a title states it, in words: '1 person (decided, p=0.97)', or
+    'undetermined (most likely 1 person, p=0.75)' when it may not be relied upon; the same words
+    over a table and over a figure. A title starts with the answer ('count = 1'), for grep."""
     p = max(result["probabilities"])
-    if result.get("confident", True):
-        return f"{result['label']} (p={p:.2f})"
-    return f"undetermined (most likely {result['label']}, p={p:.2f})"
+    said = label_text(result["label"])
+    confident = result.get("confident")
+    if confident is None:  # a result that was never judged: no claim either way
+        return f"{said} (p={p:.2f})"
+    if confident:
+        return f"{said} (decided, p={p:.2f})"
+    return f"undetermined (most likely {said}, p={p:.2f})"
+
+
+# -- the trust rule, worded once: every reason, note and page takes its figure from the card's
+# confidence level (``level``), so the figure follows whatever card ships
+
+def level_text(level) -> str:
+    """A card's confidence level as a figure: 0.97 -> '97 %', 0.975 -> '97.5 %'."""
+    return f"{float(level) * 100:.1f}".rstrip("0").rstrip(".") + " %"
+
+
+def not_often_enough(what: str, signal_db, level, band: str) -> str:
+    """Why an answer whose cell of the card has no threshold is not decided."""
+    return (f"'{what}' at signal {format_db(signal_db)} dB: answers like this were not right often enough in "
+            f"validation to be relied on ({level_text(level)} needed; {band})")
+
+
+def under_threshold(p: float, what: str, signal_db, level, t: float) -> str:
+    """Why an answer under its cell's threshold is not decided."""
+    return (f"p={p:.3f} for '{what}' at signal {format_db(signal_db)} dB: answers like this were right "
+            f"{level_text(level)} of the time in validation only from p={t:.3f}")
+
+
+def decided_text(level) -> str:
+    """What a decided answer means, in words (tables, pages)."""
+    if level is None:
+        return "decided"
+    return f"decided: answers like this were right at least {level_text(level)} of the time in validation"

@@ -125,3 +125,58 @@ def test_the_shipped_pair_is_calibrated():
 
     m = load_count()
     assert m.calibrated, "models/count.json's two_stage block must name the shipped activity model"
+
+
+# -- activity is answered for one person: where two may be moving it is not decided ------------
+
+def test_activity_is_not_decided_on_the_bundled_two_person_clips():
+    """examples/two-walking.mp4 and two-mixed.mp4: the activity net is sure (walking, p = 1.00)
+    and its card would decide, but its answer is not defined with two people; the count net on
+    the same windows says two people are possible, so neither the clip nor any window is decided."""
+    from pathlib import Path
+
+    from wallcli.infer.classify import classify_video
+    from wallcli.infer.twostage import load_classifier
+
+    model = load_classifier("activity")
+    for name in ("two-walking", "two-mixed"):
+        clip = Path(__file__).resolve().parents[2] / "examples" / f"{name}.mp4"
+        res, _ = classify_video(model, str(clip), stride=int(model.card["stride"]))
+        assert res["label"] == "walking" and max(res["probabilities"]) > 0.99
+        assert res["confident"] is False, name
+        assert "one activity is not defined" in res["reason"] and res["two_people"] >= 0.03
+        assert all(w["confident"] is False and "two people" in w["reason"] for w in res["windows"])
+
+
+def test_the_two_people_check_and_its_words():
+    from wallcli.infer.twostage import OnePersonActivity, two_people_reason
+
+    assert two_people_reason(0.6, 0.97).startswith("two people likely (p=0.60")
+    assert "two people possible (p=0.10" in two_people_reason(0.1, 0.97)
+
+    class Net:  # the shape of a Model, as far as the check reads it
+        def __init__(self, task, classes, card):
+            self.task, self.classes, self.card, self.path = task, classes, card, None
+            self.fps, self.window, self.bins, self.input_names = 30.0, 256, 64, ["horizontal"]
+
+    act = Net("activity", ["none", "walking", "crouching", "waving", "jumping"],
+              {"sha256": "a", "confidence": {"level": 0.97}})
+    count = Net("count", [0, 1, 2], {"two_stage": {"prior_two_vs_one": 1.0}})
+    gate = OnePersonActivity(act, count)
+    sure_one = np.array([0.0, 1.0, 0, 0, 0, 0.0, 0.99, 0.01])
+    assert gate.gate(sure_one, "walking") == (pytest.approx(0.01), None)
+    p, why = gate.gate(np.array([0.0, 1.0, 0, 0, 0, 0.0, 0.3, 0.7]), "walking")
+    assert p == pytest.approx(0.7) and why.startswith("two people likely")
+    assert gate.gate(np.array([1.0, 0, 0, 0, 0, 0.0, 0.3, 0.7]), "none")[1] is None  # 'none' presumes nobody
+    odd = Net("count", [0, 1, 2], {})
+    odd.window = 128  # a count net that cannot read these windows: two people cannot be ruled out
+    assert "cannot be ruled out" in OnePersonActivity(act, odd).gate(sure_one, "walking")[1]
+
+
+def test_report_and_scan_check_activity_the_same_way():
+    from wallcli.batch.task import _model  # scan's (and evaluate's) loader
+    from wallcli.infer.twostage import OnePersonActivity
+    from wallcli.report.analysis import load_models
+
+    assert isinstance(_model("activity", 1), OnePersonActivity)
+    assert isinstance(load_models()["activity"], OnePersonActivity)

@@ -143,9 +143,9 @@ def test_the_headline_says_each_undetermined_answer_in_plain_words():
     block = {"level": 0.97, "signal_edges_db": [0.0], "thresholds": [[None, None, None], [0.9, None, 0.95]]}
     cases = {
         "nobody moving is never decided": ([0.99, 0.005, 0.005], 5.0),
-        "'1 person' answers were never right 97% of the time in validation at a signal like this one (4.7 dB)":
-            ([0.2, 0.7, 0.1], 4.7),
-        "its probability (0.80) is under the 0.95 from which '2 people' answers were right 97%": ([0.1, 0.1, 0.8], 3.0),
+        "'1 person' answers at a signal like this one (4.7 dB) were not right often enough in validation to be "
+        "relied on (97 % needed)": ([0.2, 0.7, 0.1], 4.7),
+        "its probability (0.80) is under the 0.95 from which '2 people' answers were right 97 %": ([0.1, 0.1, 0.8], 3.0),
     }
     for words, (probs, snr) in cases.items():
         ok, reason = judge(block, probs, snr, [0, 1, 2])
@@ -323,3 +323,54 @@ def test_report_memory_does_not_grow_with_the_clip(tmp_path, monkeypatch):
         tracemalloc.stop()
         assert a.identity["frames"] == n and set(a.results) == {"count", "activity"}
     assert peaks[2] < 1.05 * peaks[1] + 0.5e6, peaks  # the whole plot grew by 14 kB a frame
+
+
+EXAMPLES = __import__("pathlib").Path(__file__).resolve().parents[2] / "examples"
+
+
+def test_report_shows_the_views_notes(tmp_path, run_cli, monkeypatch):
+    # two-mixed.mp4: a person near the wall casts a sharp shadow; count and activity say so in
+    # their JSON's view (no fault: the clip is analysed), and the page says it too, as text
+    clip = EXAMPLES / "two-mixed.mp4"
+    code, out, err = run_cli("count", clip, "--json")
+    assert code == 0, err
+    view = json.loads(out)["view"]
+    assert view["usable"] and any(n.startswith("sharp shadow or light in view") for n in view["notes"])
+    page_path = tmp_path / "two-mixed.html"
+    code, _, err = run_cli("report", clip, "-o", page_path)
+    assert code == 0, err
+    cell = parse(page_path.read_text(encoding="utf-8")).by_id("view")
+    assert cell.text().startswith("a static view of the wall; also seen")
+    assert [li.text() for li in cell.find_all("li")] == view["notes"]
+
+    # a note is text, never markup (autoescape)
+    from wallcli.signal import view_limits
+
+    monkeypatch.setitem(view_limits.NOTES, "sharp light", "<b onclick=x>sharp</b> & light")
+    page_path = tmp_path / "escaped.html"
+    code, _, err = run_cli("report", clip, "-o", page_path)
+    assert code == 0, err
+    html = page_path.read_text(encoding="utf-8")
+    assert "&lt;b onclick=x&gt;sharp&lt;/b&gt; &amp; light (at " in html and "<b onclick" not in html
+
+
+def test_a_view_with_no_notes_lists_none(clip_report):
+    # the session's clip: its view is refused (the sweeping shadow reads as motion), with no notes
+    cell = parse(clip_report.read_text(encoding="utf-8")).by_id("view")
+    assert cell.text().startswith("not usable: ") and "also seen" not in cell.text() and not cell.find_all("li")
+
+
+@pytest.mark.parametrize("name,content,words", [
+    ("day.csv", "input,error,count.label\ncam1/a.mp4,,1\n", "is a table, not a video"),
+    ("notes.txt", "not a video\n" * 20, "is not a video"),
+])
+def test_report_of_something_it_does_not_read_names_what_it_reads(tmp_path, run_cli, name, content, words):
+    bad = tmp_path / name
+    bad.write_text(content)
+    code, out, err = run_cli("report", bad, "-o", tmp_path / "r.html")
+    assert code == 1 and out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"Error: {bad} {words}: report reads a video"), err
+    assert "the .jsonl results of 'wallcli scan'" in lines[0]
+    assert "Errno" not in err and "Traceback" not in err  # FFmpeg's words at most, never PyAV's errno
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]

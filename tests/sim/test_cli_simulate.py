@@ -79,3 +79,25 @@ def test_crf_is_refused_where_it_would_not_apply(tmp_path, run_cli, suffix):
     code, _, err = run_cli("simulate", "-o", out, "--size", "32x32", "--duration", "0.4", "--fps", "15",
                            "--grid", "4x4")
     assert code == 0, err
+
+
+def test_simulate_shows_a_progress_bar_on_a_terminal_only(tmp_path, run_cli, monkeypatch):
+    import io
+    import re
+
+    from rich.console import Console
+
+    import wallcli.cli.output as output
+
+    # stderr not a terminal (a pipe, a log file): not a character of a bar, only the 'wrote' line
+    code, out, err = run_cli("simulate", "-o", tmp_path / "a.mkv", "--seed", "1", *FAST)
+    assert code == 0 and out == "" and err.startswith("wrote ") and len(err.strip().splitlines()) == 1
+    # stderr a terminal: the bar counts the frames rendered, on stderr (stdout untouched)
+    term = io.StringIO()
+    monkeypatch.setattr(output, "console_err", Console(file=term, force_terminal=True, width=100, highlight=False,
+                                                       markup=False))
+    code, out, err = run_cli("simulate", "-o", tmp_path / "b.mkv", "--seed", "1", *FAST)
+    assert code == 0 and out == "", err
+    shown = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", term.getvalue())
+    assert "simulate" in shown and re.search(r"\b\d+/9\b", shown), shown[-400:]
+    assert "wrote " in shown  # the line that names the files follows the bar

@@ -35,6 +35,9 @@ def test_sidecar_has_contract_fields_and_positions():
     assert t["activity"] in motion.ACTIVITIES
     assert len(t["persons"]) == 2 and all(len(p["positions"]) == 15 for p in t["persons"])
     assert sample_scene(1, SceneConfig(people=0, duration=0.5)).truth()["activity"] == "none"
+    # 'moving' is what count answers: a person standing still is in 'people' and not in 'moving'
+    still = sample_scene(1, SceneConfig(people=2, activities=["none", "walking"], duration=0.5, grid=(8, 8))).truth()
+    assert still["people"] == 2 and still["moving"] == 1 and "standing still counts 0" in still["moving_note"]
 
 
 def test_walkers_keep_speed_distance_and_can_cross():

@@ -27,6 +27,10 @@ ACTIVITY_MODEL_OPT = typer.Option(None, "--activity-model", help="The activity m
 SINGLE_STAGE_OPT = typer.Option(False, "--single-stage", help="Count with the count net alone (the paper's "
                                 "design: the horizontal plot only), not in two stages.")
 THREADS_OPT = threads_option("onnxruntime intra-op threads (0: onnxruntime chooses).")
+VERBOSE_OPT = typer.Option(False, "--verbose", "-v", help="Also print, on stderr, how often the model was right in "
+                           "validation (its card's figures, on simulated and independently rendered clips) and where "
+                           "each window's reason is. Without it: the table and one line saying why the answer is "
+                           "decided or not.")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
 FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
@@ -41,7 +45,7 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
         no_shake: bool = False, stream: Optional[int] = None, activity_model: Optional[Path] = None,
-        single_stage: bool = False) -> None:
+        single_stage: bool = False, verbose: bool = False) -> None:
     from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 
@@ -65,6 +69,8 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     if task == "count" and not single_stage:
         reads.append(activity_model or shipped_model_path("activity"))
     check_png_names(("--plot", plot))
+    if task == "activity":  # its answers are checked by the count net for two people
+        reads.append(shipped_model_path("count"))
     check_outputs([plot], force=force, inputs=reads)
     model = load_classifier(task, model_path, threads=threads, activity_path=activity_model, single=single_stage)
     stride = int(stride or model.card["stride"])
@@ -92,25 +98,29 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     if strict:
         refuse_view(input, result.get("view"))
     with committed_together():  # the figure and the data on stdout: all or none
-        _report(task, input, model, result, st, plot, json_out, force)
+        _report(task, input, model, result, st, plot, json_out, force, verbose=verbose)
     from wallcli.cli.output import wrote
 
     wrote((plot, "class probabilities over time above the horizontal space-time plot"))
 
 
-def _report(task, input, model, result, st, plot, json_out, force) -> None:
-    from wallcli.cli.output import emit_json, print_lines, print_table
+def _report(task, input, model, result, st, plot, json_out, force, *, verbose: bool = False) -> None:
+    from wallcli.cli.output import emit_json, log, print_lines, print_table
 
     if plot is not None:
         from wallcli.plots.timeline import save_timeline_png
 
         save_timeline_png(plot, result, st, force=force)
+    # the model card's figures are for a reader who asks (-v), on stderr: not on every call
+    note = accuracy_note(model.card, single_stage=task == "count" and model.single) if verbose else None
     if json_out:
         emit_json(result)
+        if note:
+            log(note)
         return
     # one row per window (each lasts window/fps seconds from its start) and the clip's answer;
     # no 'end' column, and reasons under the table, so that five classes fit 80 columns
-    from wallcli.wording import answer_text, format_db, label_text
+    from wallcli.wording import answer_text, decided_text, format_db, label_text
 
     def shown(r):  # an answer that may not be relied upon is not shown as one
         return str(r["label"]) if r.get("confident", True) else "undetermined"
@@ -123,24 +133,24 @@ def _report(task, input, model, result, st, plot, json_out, force) -> None:
     n = len(result["windows"])
     print_table(f"{input}: {task} = {answer_text(result)}; {n} window{'' if n == 1 else 's'} of {span:.2f} s",
                 ["start (s)", "answer", "signal dB", *map(label_text, result["classes"])], rows)
-    notes = []
-    if not result.get("confident", True):
-        notes.append(f"undetermined: {result.get('reason') or 'no reason given'}.")
-    if any(not w.get("confident", True) for w in result["windows"]):
-        notes.append("Each window's reason: --json (windows[].reason).")
-    print_lines(notes)
-    note = accuracy_note(model.card, single_stage=task == "count" and model.single)
+    # one line under the table: why the clip's answer is decided or not
+    if result.get("confident") is True:
+        level = (model.card.get("confidence") or {}).get("level")
+        print_lines([f"{decided_text(level)}."])
+    elif result.get("confident") is False:
+        print_lines([f"undetermined: {result.get('reason') or 'no reason given'}."])
     if note:
-        from wallcli.cli.output import log
-
+        if any(not w.get("confident", True) for w in result["windows"]):
+            log("Each window's reason: --json (windows[].reason).")
         log(note)
 
 
 def accuracy_note(card: dict, single_stage: bool = False) -> str | None:
     """One line saying how far the model's answers can be trusted, from its card's validation.
 
-    Printed under the table (to stderr, for the reader, not for scripts): a probability of 0.9
-    from a model that is right on 64 % of windows is not a 90 % answer.
+    Printed with -v (to stderr, for the reader, not for scripts; not on every call, where it was
+    six lines under every table): a probability of 0.9 from a model that is right on 64 % of
+    windows is not a 90 % answer.
     """
     tr = card.get("transfer") or {}
     if single_stage and tr.get("stages"):  # the card's headline is the two-stage count's, not this net's alone

@@ -6,7 +6,8 @@ from typing import Optional
 
 from wallcli.cli.common import stream_option
 from wallcli.cli._classify import (FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
-                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT, run)
+                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT,
+                                   VERBOSE_OPT, run)
 
 
 def activity(
@@ -24,6 +25,7 @@ def activity(
     no_deflicker: bool = NO_DEFLICKER_OPT,
     no_exposure: bool = NO_EXPOSURE_OPT,
     no_shake: bool = NO_SHAKE_OPT,
+    verbose: bool = VERBOSE_OPT,
 ) -> None:
     """Recognise what a person out of view is doing: none, walking, crouching, waving or jumping.
 
@@ -32,13 +34,17 @@ def activity(
     You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §2); the clip's answer is
     the mean of the window probabilities.
 
+    The table's title states the clip's answer, decided or undetermined, and the line under it
+    why; -v (--verbose) adds, on stderr, how often the model was right in validation.
+
     \b
     Examples:
       wallcli activity clip.mp4
+      wallcli activity clip.mp4 -v
       wallcli activity plots.npz --json
       wallcli activity clip.mp4 --plot timeline.png --stride 32
       ffmpeg -i rtsp://cam/stream -f nut - | wallcli activity - --follow
     """
     run("activity", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,
-        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake, stream=stream)
+        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake, stream=stream, verbose=verbose)

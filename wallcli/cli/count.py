@@ -7,7 +7,8 @@ from typing import Optional
 from wallcli.cli.common import stream_option
 from wallcli.cli._classify import (ACTIVITY_MODEL_OPT, SINGLE_STAGE_OPT, FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT,
                                    MODEL_OPT, PLOT_OPT, ROI_OPT,
-                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT, run)
+                                   STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT,
+                                   VERBOSE_OPT, run)
 
 
 def count(
@@ -27,8 +28,12 @@ def count(
     no_shake: bool = NO_SHAKE_OPT,
     activity_model: Optional[Path] = ACTIVITY_MODEL_OPT,
     single_stage: bool = SINGLE_STAGE_OPT,
+    verbose: bool = VERBOSE_OPT,
 ) -> None:
     """Count the people (0, 1 or 2) moving out of view, from the light on a blank wall.
+
+    count counts the people who move: a person standing still counts 0 (a still person's
+    sway can still show on a strong signal, and is then counted; see the README).
 
     The space-time plots are cut into 256-frame windows (8.5 s at 30 fps, any input frame
     rate is resampled). Two stages answer: is anybody moving (the count net, which reads the
@@ -37,9 +42,13 @@ def count(
     window probabilities; the JSON's "stages" says what each stage found. --single-stage
     counts with the count net alone (Sharma et al., ICCV 2021, supplementary §2).
 
+    The table's title states the clip's answer, decided or undetermined, and the line under it
+    why; -v (--verbose) adds, on stderr, how often the model was right in validation.
+
     \b
     Examples:
       wallcli count clip.mp4
+      wallcli count clip.mp4 -v
       wallcli count plots.npz --json
       wallcli count clip.mp4 --plot timeline.png --stride 32
       ffmpeg -i rtsp://cam/stream -f nut - | wallcli count - --follow
@@ -47,4 +56,4 @@ def count(
     run("count", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,
         no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake, stream=stream,
-        activity_model=activity_model, single_stage=single_stage)
+        activity_model=activity_model, single_stage=single_stage, verbose=verbose)

@@ -11,6 +11,17 @@ from wallcli.cli.common import (stream_option, ROI_HELP, THREADS_HELP, correctio
                                 parse_roi, refuse_view, strict_option, threads_option)
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
+# what report reads, said in every error about an input it cannot read (as the INPUT help says it)
+ACCEPTS = ("report reads a video (file, http(s)/rtsp URL, or '-' for a stream on stdin) or the .jsonl "
+           "results of 'wallcli scan'")
+
+
+def _not_readable(input: str) -> str:
+    """The one error line for an input that is neither a video nor scan's .jsonl."""
+    if str(input).lower().endswith((".csv", ".tsv")):  # scan -o day.csv: for spreadsheets, not read back
+        return (f"{input} is a table, not a video: {ACCEPTS} (scan's .csv is for spreadsheets; "
+                "write its results with -o results.jsonl for a report)")
+    return f"{input} is not a video: {ACCEPTS}"
 
 
 def report(
@@ -62,6 +73,10 @@ def report(
         raise UsageError(f"-o must end in .html (got {output})")
     roi_t = parse_roi(roi)
     results = str(input).lower().endswith(RESULTS_SUFFIXES)
+    if str(input).lower().endswith((".csv", ".tsv")) and Path(input).is_file():
+        from wallcli.errors import WallcliError
+
+        raise WallcliError(_not_readable(input))
     if results and (roi_t or count_model or activity_model or no_deflicker or no_exposure or no_shake
                     or stream is not None):
         raise UsageError("--roi, --count-model, --activity-model, --stream and --no-deflicker/--no-exposure/--no-shake apply "
@@ -96,10 +111,16 @@ def report(
         from wallcli.report.analysis import analyse, load_models
         from wallcli.report.pages import clip_page
 
+        from wallcli.errors import WallcliError
+        from wallcli.io.video import NotAVideo
+
         models = load_models(count_model, activity_model)
-        with progress("report", None) as advance:
-            analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance,
-                               corrections=corrections_of(no_deflicker, no_exposure, no_shake))
+        try:
+            with progress("report", None) as advance:
+                analysis = analyse(input, roi=roi_t, models=models, threads=threads, progress=advance,
+                                   corrections=corrections_of(no_deflicker, no_exposure, no_shake))
+        except NotAVideo as exc:  # FFmpeg's words alone do not say what report would have read
+            raise WallcliError(f"{_not_readable(input)} ({exc.detail})") from None
         if strict:
             refuse_view(input, analysis.view)
         for w in analysis.warnings:

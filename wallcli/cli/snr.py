@@ -206,9 +206,6 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         refuse_view(input, result["view"])
     res = acc.result()
     notes = result["warnings"]
-    from wallcli.signal.snr_verdict import snr_verdict
-
-    result["verdict"] = snr_verdict(result)
     if auto:
         result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
                           "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0)),
@@ -309,10 +306,10 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
     if sweep is None:
         out = _one(params, approx)
         if json_out:
-            emit_json({"mode": "predict", "parameters": settings, **out})
+            emit_json({"mode": "predict", "parameters": settings, **out, "units": {k: UNITS[k] for k in out}})
             return
         print_table("snr --predict (Sharma et al., ICCV 2021, supplementary §3.1)" + (", far-field approximation" if approx else ""),
-                    ["quantity", "value"], [[k, _shown(k, v)] for k, v in out.items()])
+                    ["quantity", "value", "unit"], [[k, _shown(k, v), UNITS.get(k, "")] for k, v in out.items()])
         if params["mean_code"] is None:
             warn("no camera model: give --mean-code and --gain for noise power and SNR")
         return
@@ -333,12 +330,26 @@ def _predict(params: dict, *, approx: bool, sweep, plot, json_out, force) -> Non
         wrote((plot, f"predicted {what} against {key.replace('_', '-')}"))
     if json_out:
         emit_json({"mode": "predict", "parameters": settings, "sweep": {"parameter": key.replace("_", "-"), "values": values},
-                   "rows": rows})
+                   "rows": rows, "units": {k: UNITS[k] for k in rows[0] if k in UNITS}})
         return
     cols = [key.replace("_", "-"), "theta", "amplitude", "signal_power"] + (
         ["noise_power", "snr_db"] if "noise_power" in rows[0] else [])
-    print_table(f"snr --predict, sweeping {key.replace('_', '-')}", cols,
+    print_table(f"snr --predict, sweeping {key.replace('_', '-')} (theta: fraction of the wall point's view "
+                "the person blocks; cv: code values of an 8-bit video)", [_headed(c) for c in cols],
                 [[_shown(c, r.get(c)) for c in [key] + cols[1:]] for r in rows])
+
+
+# what each predicted quantity is measured in: radiances are in code values (what a white wall lit
+# by that radiance alone would record, signal_predict.predict), so powers are code values squared
+UNITS = {"theta": "fraction of view blocked", "amplitude": "code values", "signal_power": "code values²",
+         "noise_power": "code values²", "shot": "code values²", "read": "code values²",
+         "quantisation": "code values²", "snr": "ratio", "snr_db": "dB"}
+_SHORT = {"theta": "", "amplitude": "cv", "signal_power": "cv²", "noise_power": "cv²", "snr_db": "dB"}
+
+
+def _headed(col: str) -> str:
+    """A sweep table's column with its unit (short: cv = code values of an 8-bit video)."""
+    return f"{col} ({_SHORT[col]})" if _SHORT.get(col) else col
 
 
 def _shown(name: str, value) -> str:

@@ -69,7 +69,8 @@ def train(
                                       "in units of the window's frame-to-frame noise, asinh-compressed, so a faint "
                                       "second mover is not scaled away by a strong first; v3 = v1 after the whole-wall light change (flicker, "
                                       "drift) is projected out of every sample (wallcli/signal/window.py)."),
-    arch: str = typer.Option("seed", "--arch", help="Network: 'seed' = the paper's nets exactly (Sharma et al., ICCV 2021, supplementary §2) (count reads the "
+    arch: str = typer.Option("paper", "--arch", help="Network: 'paper' = the paper's nets exactly (Sharma et al., ICCV 2021, supplementary §2; 'seed', "
+                             "the name of earlier versions, is accepted for it) (count reads the "
                              "horizontal plot, activity both); 'lite' = both plots for either task, time averaged in "
                              "pairs and 32 channels (about a quarter of the paper's count net's work; wallcli/train/nets.py)."),
     balance: bool = typer.Option(False, "--balance", help="Weight the loss by the inverse frequency of each class "
@@ -141,8 +142,12 @@ def train(
     versions = {"v1": NORMALIZATION, "v2": NORMALIZATION_V2, "v3": NORMALIZATION_V3}
     if preprocessing not in versions:
         raise UsageError(f"--preprocessing must be v1, v2 or v3 (got {preprocessing!r})")
+    # 'paper' is what users type; 'seed' (the project's starting design) stays the name the
+    # training code and existing model cards use for it
+    arch = "seed" if arch == "paper" else arch
     if arch not in ARCHS:
-        raise UsageError(f"--arch must be {' or '.join(ARCHS)} (got {arch!r})")
+        shown = ["paper" if a == "seed" else a for a in ARCHS]
+        raise UsageError(f"--arch must be {' or '.join(shown)} (got {arch!r})")
     prep = versions[preprocessing]
     if device not in ("cpu", "cuda"):
         raise UsageError(f"--device must be cpu or cuda (got {device!r})")

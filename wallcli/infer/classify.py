@@ -61,19 +61,34 @@ def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None
     return confident, reason
 
 
+def _gate(model, raw, probs, confident: bool, reason):
+    """An activity answer where two people may be moving is not decided, whatever the net says
+    (:class:`wallcli.infer.twostage.OnePersonActivity`); its reason replaces the model's."""
+    if not hasattr(model, "gate"):
+        return confident, reason
+    why = model.gate(raw, model.classes[int(np.argmax(probs))])[1]
+    return (False, why) if why else (confident, reason)
+
+
+def _round(x):
+    return None if x is None else round(float(x), 6)
+
+
 def _window_record(model, start: float, raw: np.ndarray, signal_db: float) -> dict[str, Any]:
     """One window's answer from the model's raw output for it (for a two-stage count, both nets')."""
     probs = model.combine(raw)[0]
     k = int(np.argmax(probs))
     # judged on the figure the JSON carries, so that the reason quotes exactly that figure
     signal_db = round(float(signal_db), 2)
-    confident, reason = _judge(model, probs, signal_db)
+    confident, reason = _gate(model, raw, probs, *_judge(model, probs, signal_db))
     rec = {"start": round(float(start), 4), "end": round(float(start + model.window / model.fps), 4),
            "label": model.classes[k], "probabilities": [float(p) for p in probs],
            "confident": confident, "reason": reason, "signal_db": signal_db}
     stages = model.stages(raw)
     if stages is not None:
         rec["stages"] = stages
+    if hasattr(model, "gate"):
+        rec["two_people"] = _round(model.gate(raw, rec["label"])[0])
     return rec
 
 
@@ -97,7 +112,7 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str, found=N
     clip = model.combine(raw)[0]
     clip = clip / clip.sum()
     clip_db = round(float(np.mean(signal_db)), 2)
-    confident, reason = _judge(model, clip, clip_db)
+    confident, reason = _gate(model, raw, clip, *_judge(model, clip, clip_db))
     out = {
         "input": source,
         "task": model.task,
@@ -115,6 +130,8 @@ def _result(model, times, probs, signal_db, *, stride: int, source: str, found=N
         "windows": [_window_record(model, t, pr, db) | {"corrections": corr.merge([f])}
                     for t, pr, db, f in zip(times, probs, signal_db, found)],
     }
+    if hasattr(model, "gate"):  # activity: how likely two people are, from the count net
+        out["two_people"] = _round(model.gate(raw, out["label"])[0])
     if model.stages(raw) is not None:  # a two-stage count: what each stage found for the clip
         from wallcli.infer.twostage import stages_info
 
@@ -361,7 +378,9 @@ def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64,
 
 def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
            corrections: corr.Options = corr.Options()) -> Iterator[dict[str, Any]]:
-    """One result per window, yielded as soon as its last frame is decoded.
+    """One result per window, yielded as soon as its last frame is decoded; when the input ends
+    (a file, a stream that closes), the end-aligned last window, then the clip's result (the
+    object of :func:`classify_video`, with ``windows``): the same windows as the whole run.
 
     Rows are raw (not clip-mean-removed): ``normalize_window`` removes each window's own
     mean, so no clip mean, which a live stream does not have, is needed.
@@ -372,22 +391,30 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     from wallcli.signal.tnr import TemporalNoise, bound_result
     from wallcli.signal.view import ViewCheck
 
-    windower = StreamWindower(model.window, stride)
+    # the classifier of classify_video, so that the lines are its windows (and its clip answer)
+    classifier = WindowClassifier(model, stride, corrections=corrections)
     check = ViewCheck(roi)
     blend = TemporalNoise()
     with open_video(source, threads=threads) as reader:
+        classifier.native_fps = float(reader.info.fps)
         # cleaned as in classify_video (a line lists no corrections of the clip's)
         unique = CameraPipeline(reader, check)
         rows = RowStream(FrameTee(unique, (check, blend)), roi=roi, bins=model.bins, fps=model.fps,
                          vertical="vertical" in model.input_names or corrections.light, register=corrections.shake)
         for t, row in rows:
-            done = windower.push(t, stream_row(row, rows))
-            if done is not None:
-                p, db, found = _predict_window(model, done[2], rows.ref, start=done[0], native=float(reader.info.fps),
-                                               options=corrections)
-                rec = _window_record(model, done[0], p, db) | {"corrections": corr.merge([found])}
+            n = len(classifier.times)
+            classifier.push(t, stream_row(row, rows), rows.ref)
+            if len(classifier.times) > n:
+                rec = _window_record(model, classifier.times[-1], classifier.probs[-1], classifier.signal[-1])
+                rec |= {"corrections": corr.merge([classifier.found[-1]])}
                 # what the frames so far say of the noise (a window holds 256 of them)
                 yield bound_result(judge_view(rec, check.view(rec["start"], rec["end"])), blend.correction())
-        if windower.count < model.window:
+        if classifier.windower.last() is None:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)
+    result = with_view(classifier.result(str(source), frames=unique.decoded), check)
+    result["corrections"] += unique.corrections()
+    result = bound_result(result, blend.correction())
+    if len(result["windows"]) > len(classifier.times):  # the end-aligned last window
+        yield result["windows"][-1]
+    yield result

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from wallcli.wording import format_db, label_text
+from wallcli.wording import format_db, label_text, not_often_enough, under_threshold
 
 FORMAT = "wallcli.confidence v1"
 MIN_SUPPORT = 25  # validation windows a threshold must rest on
@@ -133,10 +133,9 @@ def judge(block: dict[str, Any] | None, probs, snr_db: float, classes: list[Any]
         return False, (f"{seen} (signal {format_db(snr_db)} dB): an empty room and a person too "
                        "faint to show give the same plot")
     if t is None:
-        return False, (f"'{what}' at signal {format_db(snr_db)} dB: never {level:.0%} right in validation "
-                       f"({_band_text(edges, b)})")
+        return False, not_often_enough(what, snr_db, level, _band_text(edges, b))
     if probs[k] < t:
-        return False, f"p={probs[k]:.3f} for '{what}' at signal {format_db(snr_db)} dB; {level:.0%} right only from p={t:.3f}"
+        return False, under_threshold(float(probs[k]), what, snr_db, level, t)
     return True, None
 
 

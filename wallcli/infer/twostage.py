@@ -153,4 +153,95 @@ def load_classifier(task: str, path=None, *, threads: int = 0, activity_path=Non
 
     if task == "count":
         return load_count(path, activity_path=activity_path, threads=threads, single=single)
+    if task == "activity":  # checked for two people by the shipped count net
+        return with_count_check(load_model(task, path, threads=threads), threads=threads)
     return load_model(task, path, threads=threads)
+
+
+NO_COUNT_REASON = ("the count model cannot read this activity model's windows, so two people cannot be ruled "
+                   "out: one activity is not defined for two people")
+
+
+def two_people_reason(p_two: float, level: float) -> str:
+    """Why an activity answer is not decided where two people may be moving (the one wording)."""
+    from wallcli.wording import level_text
+
+    if p_two >= 0.5:
+        return f"two people likely (p={p_two:.2f} of two among people moving): one activity is not defined"
+    return (f"two people possible (p={p_two:.2f} of two among people moving; a decided answer must be right "
+            f"{level_text(level)} of the time): one activity is not defined for two people")
+
+
+class OnePersonActivity:
+    """The activity task's classifier: the activity net, checked by the count net on the same windows.
+
+    The activity net was trained and validated on rooms with one person, so its answer is not
+    defined with two. A decided answer must be right at the card's level (e.g. 97 %), and it can only be
+    right if one person moves; so it may be decided only where the two-stage count (this pair of
+    nets, the count card's prior odds) leaves two people less likely than the answers may be wrong,
+    1 - level. The count net reads the horizontal plot, which the activity path already has. Raw
+    output per window: the activity net's 5 probabilities, then the count net's 3."""
+
+    task = "activity"
+    single = True
+
+    def __init__(self, activity, count):
+        self.activity, self.card, self.path = activity, activity.card, activity.path
+        self.k = len(activity.classes)
+        try:
+            self.pair = TwoStageCount(count, activity)
+        except WallcliError:  # your own activity model, on windows the count net cannot read
+            self.pair = None
+        self.count = count if self.pair is not None else None
+
+    classes = property(lambda self: self.activity.classes)
+    window = property(lambda self: self.activity.window)
+    bins = property(lambda self: self.activity.bins)
+    fps = property(lambda self: self.activity.fps)
+
+    @property
+    def input_names(self) -> list[str]:
+        return self.pair.input_names if self.pair is not None else self.activity.input_names
+
+    def info(self) -> dict[str, str]:
+        return self.activity.info()
+
+    def classify(self, wins, offsets) -> np.ndarray:
+        own = self.activity.classify(wins, offsets)
+        return own if self.count is None else np.concatenate([own, self.count.classify(wins, offsets)], axis=1)
+
+    def combine(self, raw: np.ndarray) -> np.ndarray:
+        return np.atleast_2d(raw)[:, :self.k]
+
+    def stages(self, raw) -> None:
+        return None
+
+    def no_block_reason(self) -> None:
+        return None
+
+    def two_people(self, raw) -> float | None:
+        """P(two people | somebody moves) of the two-stage count on this answer's windows (None:
+        no count net reads them)."""
+        if self.pair is None:
+            return None
+        raw = np.atleast_2d(np.asarray(raw, np.float64))
+        p = combine(raw[:, self.k:], raw[:, :self.k], self.pair.two_odds)[0]
+        return float(p[2] / max(p[1] + p[2], 1e-300))
+
+    def gate(self, raw, label) -> tuple[float | None, str | None]:
+        """(P(two | somebody), the reason the answer may not be decided, or None)."""
+        p_two = self.two_people(raw)
+        if label == "none":  # never decided anyway, and it presumes nobody rather than one
+            return p_two, None
+        if p_two is None:
+            return None, NO_COUNT_REASON
+        block = self.card.get("confidence") or {}
+        level = float(block.get("level", 1.0))
+        return p_two, (None if p_two < 1 - level else two_people_reason(p_two, level))
+
+
+def with_count_check(activity, count=None, *, threads: int = 0):
+    """``activity`` checked by ``count`` (default: the shipped count net) for two people."""
+    from wallcli.infer.model import load_model
+
+    return OnePersonActivity(activity, count if count is not None else load_model("count", threads=threads))

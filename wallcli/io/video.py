@@ -103,13 +103,26 @@ def _real_video(stream) -> bool:
     return not still and stream.codec_context is not None
 
 
+class NotAVideo(WallcliError):
+    """FFmpeg opened the input but found no video in it (a text file, a CSV, a cut header): a
+    command that reads something else too (``wallcli report``) can say what it accepts.
+    ``detail``: what was found, without the input's name ("FFmpeg: Invalid data found ...")."""
+
+    def __init__(self, message: str, detail: str = ""):  # a default: unpickled (a scan worker) from args
+        super().__init__(message)
+        self.detail = detail or message
+
+
 def _describe_open_error(source: str, exc: Exception) -> WallcliError:
     text = str(exc)
     if isinstance(exc, FileNotFoundError) or "No such file" in text:
         return WallcliError(f"no such file: {source}")
     if "Permission denied" in text:
         return WallcliError(f"cannot read {source}: permission denied")
-    return WallcliError(f"{source} is not a readable video (FFmpeg: {text.strip() or type(exc).__name__})")
+    # FFmpeg's own words, without PyAV's "[Errno 1094995529] ...: 'path'" around them (an AVERROR
+    # tag read as a number, and the path the line already names)
+    why = getattr(exc, "strerror", None) or text.strip() or type(exc).__name__
+    return NotAVideo(f"{source} is not a readable video (FFmpeg: {why})", f"FFmpeg: {why}")
 
 
 def _is_url(source: str) -> bool:
@@ -154,7 +167,7 @@ class VideoReader:
             raise _describe_open_error(source, exc) from None
         if not self._container.streams.video:
             self._container.close()
-            raise WallcliError(f"{source} has no video stream")
+            raise NotAVideo(f"{source} has no video stream", "it has no video stream")
         try:
             stream = self._pick_stream(source, STREAM.get() if stream_index is None else stream_index)
         except WallcliError:

@@ -123,10 +123,13 @@ def load_models(count_model=None, activity_model=None, threads: int = 0) -> dict
     if models["count"].bins != models["activity"].bins:
         raise UsageError(f"the count model reads {models['count'].bins} bins and the activity model "
                          f"{models['activity'].bins}; a report draws both from one space-time plot")
-    from wallcli.infer.twostage import TwoStageCount
+    from wallcli.infer.twostage import OnePersonActivity, TwoStageCount
 
-    # count in two stages, as `wallcli count` answers: presence from both nets, then how many
-    models["count"] = TwoStageCount(models["count"], models["activity"])
+    # count in two stages, as `wallcli count` answers: presence from both nets, then how many;
+    # activity checked by the count net for two people, as `wallcli activity` answers
+    count_net = models["count"]
+    models["count"] = TwoStageCount(count_net, models["activity"])
+    models["activity"] = OnePersonActivity(models["activity"], count_net)
     return models
 
 

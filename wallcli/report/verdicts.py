@@ -61,11 +61,14 @@ def plain_why(reason: str | None, obj: dict[str, Any]) -> str:
     if m:
         return ("nobody moving is never decided, since an empty room and a person too faint to show give "
                 f"the same plot (signal {m.group(1)} dB)")
-    m = re.match(r"^'(.+?)' at signal (\S+) dB: never (\d+%) right in validation", reason)
+    # confidence.judge's reasons, worded by wallcli.wording (not_often_enough, under_threshold)
+    m = re.match(r"^'(.+?)' at signal (\S+) dB: answers like this were not right often enough in validation "
+                 r"to be relied on \(([\d.]+ %) needed", reason)
     if m:
-        return (f"this model's '{m.group(1)}' answers were never right {m.group(3)} of the time in "
-                f"validation at a signal like this one ({m.group(2)} dB)")
-    m = re.match(r"^p=(\S+) for '(.+?)' at signal (\S+) dB; (\d+%) right only from p=(\S+)", reason)
+        return (f"this model's '{m.group(1)}' answers at a signal like this one ({m.group(2)} dB) were not right "
+                f"often enough in validation to be relied on ({m.group(3)} needed)")
+    m = re.match(r"^p=(\S+) for '(.+?)' at signal (\S+) dB: answers like this were right ([\d.]+ %) of the time "
+                 r"in validation only from p=(\S+)", reason)
     if m:
         return (f"its probability ({float(m.group(1)):.2f}) is under the {float(m.group(5)):.2f} from which "
                 f"'{m.group(2)}' answers were right {m.group(4)} of the time in validation")

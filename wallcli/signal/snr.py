@@ -459,7 +459,8 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
     """The object of ``wallcli snr --json`` (docs/contract.md) from a fed accumulator.
 
     One builder for ``wallcli snr`` and ``wallcli scan`` (which feeds the accumulator from the
-    decode that also makes the space-time plots), so both report the same fields.  ``notes``:
+    decode that also makes the space-time plots), so both report the same fields, the one-line
+    ``verdict`` (:func:`~wallcli.signal.snr_verdict.snr_verdict`) included.  ``notes``:
     the reader's warnings, listed before the estimator's own.
     """
     acc.finish()
@@ -468,7 +469,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
                            f"{MIN_FRAMES} (it compares consecutive frames over time)")
     res = acc.result()
     top = res.scale(1)
-    return {
+    out = {
         "input": source,
         "roi": list(res.roi),
         "frames": res.frames,
@@ -485,3 +486,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
         "warnings": [*notes, *res.warnings],
         "corrections": acc.corrections,
     }
+    from wallcli.signal.snr_verdict import snr_verdict
+
+    out["verdict"] = snr_verdict(out)  # here, not in the command: scan's snr object is this one too
+    return out

@@ -20,3 +20,11 @@
 WIDE_DOMAINS = ("wide", "steady", "bracket")
 BODY_GAIN = (0.3, 1.5)
 SHADOW_GAIN = (0.5, 3.0)
+
+
+def moving_truth(activities) -> dict:
+    """The truth file's count of people who move (what ``wallcli count`` answers; ``people``
+    counts everyone in the room), with the same words as the README and ``count --help``."""
+    from wallcli.wording import COUNT_COUNTS
+
+    return {"moving": sum(a != "none" for a in activities), "moving_note": COUNT_COUNTS}

@@ -12,7 +12,7 @@ from typing import Iterator
 
 import numpy as np
 
-from wallcli.sim import WIDE_DOMAINS, bodies, motion
+from wallcli.sim import WIDE_DOMAINS, bodies, motion, moving_truth
 from wallcli.sim.camera import Camera, CameraParams, sample_camera
 from wallcli.sim.bodylight import body_delta, body_radiance, overlapping_pairs
 from wallcli.sim.room import Room, index_interp, sample_room, static_irradiance
@@ -157,6 +157,7 @@ class Scene:
         W, D, H = self.room.size
         return {
             "people": len(self.people), "activity": self.label_activity, "activities": list(self.activities),
+            **moving_truth(self.activities),
             "fps": self.camera.fps, "frames": n, "seed": self.seed, "width": self.camera.width,
             "height": self.camera.height, "domain": self.config.domain,
             **({"world": "pt", "spp": int(self.config.spp)} if self.config.world == "pt" else {}),

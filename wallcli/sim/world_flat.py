@@ -13,6 +13,7 @@ from typing import Iterator
 
 import numpy as np
 
+from wallcli.sim import moving_truth
 from wallcli.sim.camera import Camera, CameraParams, sample_camera
 from wallcli.sim.flatland import Flatland, irradiance, occluder_tracks, sample_world
 
@@ -47,6 +48,7 @@ class FlatScene:
         centres = self.tracks.mean(axis=2)  # (T, n_occ, 2)
         return {
             "people": n, "activity": "walking" if n else "none", "activities": ["walking"] * n,
+            **moving_truth(["walking"] * n),
             "fps": self.camera.fps, "frames": len(self.times), "seed": self.seed, "world": "flatland",
             "width": self.camera.width, "height": self.camera.height, "domain": self.domain,
             "camera": self.camera.to_dict(),
