@@ -16,7 +16,7 @@ def default_cache() -> Path:
 
 
 def prepare(cfg, task: str, clips: list[Path], sim_data: list[Path], folds: int, cache: Path | None, out: Path,
-            bars, level: float) -> tuple[Any, dict[str, Any]]:
+            bars, level: float, split: list | None = None) -> tuple[Any, dict[str, Any]]:
     """(the final run's config: every recording plus ``sim_data``, the card's ``recordings`` block)."""
     from wallcli.cli.output import log, progress
     from wallcli.infer.twostage import load_classifier
@@ -33,13 +33,17 @@ def prepare(cfg, task: str, clips: list[Path], sim_data: list[Path], folds: int,
     log(f"{len(recs)} labelled clips, {windows} windows (every {HARVEST_STRIDE} samples at 30 fps)")
     if folds:
         answers = fl.cross_validate(cfg, fold_dirs, sim_data, recs, work, bars=bars, log=log,
-                                    load=lambda p: load_classifier(task, p))
+                                    load=lambda p: load_classifier(task, p), split=split)
         classes = [0, 1, 2] if task == "count" else ["none", "walking", "crouching", "waving", "jumping"]
         table, trust = judge_out_of_fold(recs, answers, task, classes, level, folds)
         block.update(fold_rule=FOLD_RULE, out_of_fold=table, confidence=trust)
         for line in [f"out of fold ({folds} folds, each answered by a model that never saw it):",
                      *fl.format_table(table, task)]:
             log(line)
+    if split:
+        from wallcli.train.folds import fit_split
+
+        block["split"] = fit_split(recs, split)
     final = replace(cfg, data=list(fold_dirs) + list(sim_data),
                     val_fraction=0.0 if cfg.val is None else cfg.val_fraction)
     return final, block
@@ -78,8 +82,34 @@ def write_block(out: Path, block: dict[str, Any]) -> dict[str, Any]:
     card = read_card(out)
     block = dict(block)
     trust = block.pop("confidence", None)
+    if "split" in block:
+        card["split"] = block.pop("split")
     card["recordings"] = block
     if trust is not None:
         card["confidence"] = trust
     write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=True)
     return read_card(out)
+
+
+def keep_init(init: Path, out: Path, block: dict[str, Any], *, name, version, force: bool) -> dict[str, Any]:
+    """``--epochs 0``: OUT is --init's graph, byte for byte, with a card that says so and carries
+    what was fitted on the recordings."""
+    from wallcli.infer.card import card_path, read_card
+    from wallcli.infer.card import sha256_file
+    from wallcli.io.writer import atomic_path, write_text_atomic
+
+    card = read_card(init)
+    with atomic_path(out, force=force) as tmp:
+        tmp.write_bytes(Path(init).read_bytes())
+    card["sha256"] = sha256_file(out)
+    card["onnx"] = dict(card.get("onnx") or {}, file=out.name) if isinstance(card.get("onnx"), dict) else card.get("onnx")
+    if name:
+        card["name"] = name
+    card["version"] = version
+    card.setdefault("training", {})["recordings_stage"] = {
+        "init": {"name": read_card(init).get("name"), "version": read_card(init).get("version"),
+                 "sha256": sha256_file(init)},
+        "note": "the net is --init's, unchanged; fitted on the recordings: " + ", ".join(
+            k for k in ("split", "confidence") if k in block or k == "confidence" and block.get("folds"))}
+    write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=force)
+    return write_block(out, block)

@@ -30,12 +30,18 @@ def train(
                                "as 'wallcli count/activity' would, print the out-of-fold table and write it in the "
                                "card ('recordings'); the decided/undetermined thresholds are fitted on those answers. "
                                "0: no folds. Then the model is trained on every clip."),
+    split: Optional[str] = typer.Option(None, "--split", help="activity with --clips: two answers the net confuses "
+                                        "(e.g. 'waving,jumping'); where the net's answer is one of them, their probability "
+                                        "is shared again by a logistic regression on the plots' physical features, fitted "
+                                        "on the recordings (wallcli/infer/split.py), out of fold with --folds."),
     clip_cache: Optional[Path] = typer.Option(None, "--clip-cache", help="Where the recordings' windows are cached "
                                               "(default: $WALLCLI_CACHE/recordings or ~/.cache/wallcli/recordings)."),
     out: Path = typer.Option(..., "--out", "-o", help="Model to write (.onnx); its card goes beside it (.json)."),
     val: Optional[Path] = typer.Option(None, "--val", help="Validation dataset folder (default: hold out --val-fraction of --data)."),
     val_fraction: float = number_option(0.1, "--val-fraction", lo=0, hi=0.5, help="Share of --data held out when there is no --val."),
-    epochs: int = number_option(20, "--epochs", lo=1, hi=100_000, integer=True, help="Total epochs (a resumed run continues up to this)."),
+    epochs: int = number_option(20, "--epochs", lo=0, hi=100_000, integer=True, help="Total epochs (a resumed run continues up to this). "
+                                "0, with --init and --clips: keep --init's net as it is and fit only what is fitted on the "
+                                "recordings (--split, the decided/undetermined thresholds)."),
     batch_size: int = number_option(32, "--batch-size", lo=2, hi=65536, integer=True, help="Windows per optimisation step."),
     threads: int = threads_option("Torch CPU threads (0: torch's default)."),
     seed: int = number_option(0, "--seed", lo=0, hi=2**32 - 1, integer=True, help="Seed of initialisation, split, batch order and augmentation."),
@@ -126,6 +132,17 @@ def train(
         raise UsageError("--folds must be 0 (none) or at least 2")
     if folds and not clips:
         raise UsageError("--folds needs --clips: folds split labelled recordings by clip")
+    if epochs == 0 and (init is None or not clips):
+        raise UsageError("--epochs 0 keeps --init's net as it is: it needs --init and --clips")
+    split_pair = None
+    if split is not None:
+        split_pair = [c.strip() for c in split.split(",")]
+        from wallcli.infer.card import TASK_CLASSES
+
+        if task.value != "activity" or not clips:
+            raise UsageError("--split applies to activity trained with --clips")
+        if len(split_pair) != 2 or split_pair[0] == split_pair[1] or any(c not in TASK_CLASSES["activity"] for c in split_pair):
+            raise UsageError(f"--split must name two activity classes, e.g. waving,jumping (got {split!r})")
     if select not in ("last", "best"):
         raise UsageError(f"--select must be last or best (got {select!r})")
     if quantize not in ("none", "int8"):
@@ -188,7 +205,13 @@ def train(
         from wallcli.cli._train_clips import prepare
 
         cfg, recordings = prepare(cfg, task.value, list(clips), list(data), folds, clip_cache, out,
-                                  lambda: _TrainProgress(console_err), confidence_level)
+                                  lambda: _TrainProgress(console_err), confidence_level, split_pair)
+        if epochs == 0:
+            from wallcli.cli._train_clips import keep_init
+
+            card = keep_init(init, out, recordings, name=name, version=model_version, force=force)
+            log(f"wrote {out} and {card_path(out).name}: the net of {init} unchanged (sha256 {card['sha256'][:12]}…)")
+            return
 
     with _TrainProgress(console_err) as bar:
         result = run_training(cfg, bar.event)

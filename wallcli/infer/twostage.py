@@ -186,8 +186,11 @@ class OnePersonActivity:
     single = True
 
     def __init__(self, activity, count):
+        from wallcli.infer.split import from_card
+
         self.activity, self.card, self.path = activity, activity.card, activity.path
         self.k = len(activity.classes)
+        self.split = from_card(activity.card)  # a second look at two answers the net confuses
         try:
             self.pair = TwoStageCount(count, activity)
         except WallcliError:  # your own activity model, on windows the count net cannot read
@@ -201,17 +204,33 @@ class OnePersonActivity:
 
     @property
     def input_names(self) -> list[str]:
-        return self.pair.input_names if self.pair is not None else self.activity.input_names
+        names = set(self.pair.input_names if self.pair is not None else self.activity.input_names)
+        if self.split is not None:
+            names |= {"horizontal", "vertical"}
+        return [n for n in ("horizontal", "vertical") if n in names]
 
     def info(self) -> dict[str, str]:
         return self.activity.info()
 
     def classify(self, wins, offsets) -> np.ndarray:
-        own = self.activity.classify(wins, offsets)
-        return own if self.count is None else np.concatenate([own, self.count.classify(wins, offsets)], axis=1)
+        """Raw output per window: the activity net's probabilities, the count net's (when it reads
+        these windows), then the window's features (when the card has a split block)."""
+        parts = [self.activity.classify(wins, offsets)]
+        if self.count is not None:
+            parts.append(self.count.classify(wins, offsets))
+        if self.split is not None:
+            from wallcli.signal.features import window_features
+
+            parts.append(window_features(wins["horizontal"], wins["vertical"], offsets["horizontal"],
+                                         offsets["vertical"]))
+        return np.concatenate(parts, axis=1)
 
     def combine(self, raw: np.ndarray) -> np.ndarray:
-        return np.atleast_2d(raw)[:, :self.k]
+        raw = np.atleast_2d(raw)
+        p = raw[:, :self.k]
+        if self.split is not None:  # the features are the last columns (a clip's: its windows' mean)
+            p = self.split.apply(p, raw[:, self.k + (3 if self.count is not None else 0):])
+        return p
 
     def stages(self, raw) -> None:
         return None
@@ -225,7 +244,7 @@ class OnePersonActivity:
         if self.pair is None:
             return None
         raw = np.atleast_2d(np.asarray(raw, np.float64))
-        p = combine(raw[:, self.k:], raw[:, :self.k], self.pair.two_odds)[0]
+        p = combine(raw[:, self.k:self.k + 3], raw[:, :self.k], self.pair.two_odds)[0]
         return float(p[2] / max(p[1] + p[2], 1e-300))
 
     def gate(self, raw, label) -> tuple[float | None, str | None]:

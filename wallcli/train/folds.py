@@ -192,7 +192,8 @@ def _identity(cfg, f: int, k: int, recs: list[Recording], extra: dict) -> str:
 
 
 def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[Recording], work: Path, *,
-                   load, bars, log=None, extra: dict | None = None) -> dict[str, dict[str, Any]]:
+                   load, bars, log=None, extra: dict | None = None,
+                   split: list | None = None) -> dict[str, dict[str, Any]]:
     """Out-of-fold answers {clip: {"probs", "signal_db", "fold"}}: for each fold, the net trained by
     ``cfg`` on the other folds (and ``sim_data``), exported, loaded with ``load(path)`` as the
     commands load it, answers the fold's clips. Each fold's answers are kept in ``work``: a rerun
@@ -207,7 +208,7 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
     answers: dict[str, dict[str, Any]] = {}
     for f in range(k):
         members = [r for r in recs if fold_of(r.name, k) == f]
-        ident = _identity(cfg, f, k, recs, extra or {})
+        ident = _identity(cfg, f, k, recs, dict(extra or {}, split=split))
         done = work / f"fold-{f}.answers.json"
         if done.is_file():
             try:
@@ -223,6 +224,14 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
             log(f"fold {f + 1}/{k}: training on {sum(len(r.starts) for r in recs if r not in members)} windows of "
                 f"{len(recs) - len(members)} clips, answering {len(members)} clips")
         onnx = work / f"fold-{f}.onnx"
+        if cfg.epochs == 0:  # the net as it is: only the split (and the thresholds) come from the recordings
+            model = load(Path(cfg.init))
+            _attach_split(model, [r for r in recs if r not in members], split)
+            got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
+                            "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
+            write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
+            answers.update(got)
+            continue
         fcfg = replace(cfg, data=[d for i, d in enumerate(fold_dirs) if i != f] + list(sim_data), val=fold_dirs[f],
                        out=onnx, checkpoint=work / f"fold-{f}-{ident}.ckpt.pt")
         with bars() as bar:
@@ -232,9 +241,43 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
                       "preprocessing": cfg.preprocessing, "stride": 64, "training_data": {"folds": [str(d) for d in fcfg.data]},
                       "training": {"fold": f, "of": k}, "validation": None}, force=True, seed=cfg.seed)
         model = load(onnx)
+        _attach_split(model, [r for r in recs if r not in members], split)
         got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
                         "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
         write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
         fcfg.checkpoint_path().unlink(missing_ok=True)
         answers.update(got)
     return answers
+
+
+def _split_data(recs: list[Recording], pair: list) -> tuple[np.ndarray, np.ndarray]:
+    """Each detectable one-person clip of the pair: its windows' mean features (at the card's
+    stride, as a clip's answer is made) and 1 for the pair's second answer."""
+    from wallcli.signal.features import window_features
+
+    use = [r for r in recs if r.activity in pair and r.persons <= 1 and r.detectable is not False]
+    if len({r.activity for r in use}) < 2:
+        raise WallcliError(f"--split {','.join(pair)}: the recordings need clips of both")
+    X = []
+    for r in use:
+        ix = r.eval_index(64)
+        X.append(window_features(r.horizontal[ix], r.vertical[ix], r.h_offset[ix], r.v_offset[ix]).mean(0))
+    return np.array(X), np.array([1.0 if r.activity == pair[1] else 0.0 for r in use])
+
+
+def fit_split(recs: list[Recording], pair: list) -> dict[str, Any]:
+    from wallcli.infer.split import fit
+
+    X, y = _split_data(recs, pair)
+    block = fit(X, y)
+    block.update(pair=list(pair), fitted_on=f"{len(y)} labelled recordings of {pair[0]} or {pair[1]} (detectable, one person)")
+    return block
+
+
+def _attach_split(model, train_recs: list[Recording], pair: list | None) -> None:
+    """The fold's model with a split fitted on the other folds' clips only."""
+    if not pair:
+        return
+    from wallcli.infer.split import Split
+
+    model.split = Split(fit_split(train_recs, pair), list(model.classes))
