@@ -315,3 +315,61 @@ def test_a_tiny_roi_is_too_small_to_check(mkv, run_cli):
     res = json.loads(out)
     assert res["view"]["usable"] is False and "too small to check" in res["view"]["issues"]
     assert res["confident"] is False
+
+
+# ------------------------------------------------------------------- 2: a jump of the timestamps
+JUMP = 10_000.0  # s, after frame 300 of 600 (30 fps): interpolated over, 300,000 rows and ~4,700 windows
+
+
+@pytest.fixture(scope="module")
+def jumpy(tmp_path_factory) -> Path:
+    from fractions import Fraction
+
+    rng = np.random.default_rng(0)
+    return write_clip(tmp_path_factory.mktemp("jump") / "j.mkv",
+                      lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)) + rng.normal(0, 2, (48, 64, 3)), 600,
+                      time_base=Fraction(1, 1000), pts_fn=lambda i: round((i / 30 + JUMP * (i >= 300)) * 1000))
+
+
+def _cli(args, timeout=120, **kw):
+    """wallcli in a child process, killed (by subprocess.run) if it outlives ``timeout``."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "wallcli", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout, **kw)
+
+
+@pytest.mark.parametrize("how", ["json", "follow", "npz"])
+def test_a_timestamp_jump_costs_nothing_and_no_window_sits_in_it(jumpy, tmp_path, how):
+    source = jumpy
+    if how == "npz":
+        source = tmp_path / "p.npz"
+        assert _cli(["stplot", jumpy, "-o", source]).returncode == 0
+    p = _cli(["count", source, "--follow" if how == "follow" else "--json"])
+    assert p.returncode == 0, p.stderr
+    windows = [json.loads(s) for s in p.stdout.splitlines()] if how == "follow" else json.loads(p.stdout)["windows"]
+    before = [w for w in windows if w["end"] <= 10.0 + 1e-3]
+    after = [w for w in windows if w["start"] >= JUMP + 10.0 - 1e-3]
+    assert before and after and len(before) + len(after) == len(windows) <= 4, [(w["start"], w["end"]) for w in windows]
+    # cut on either side of the gap, none spans it: the view check has no fault to find in them
+    assert all(w["view"]["usable"] for w in windows), [w["view"] for w in windows]
+
+
+def test_a_repeat_left_out_after_a_jump_hands_its_gap_on():
+    """The frame after a jump may copy the one before it (a recorder re-sending its last picture):
+    the repeat filter drops it, and the next frame must still restart the grid."""
+    from types import SimpleNamespace
+
+    from wallcli.io.planes import Planes
+    from wallcli.io.video import Frame
+    from wallcli.signal.repeats import RepeatFilter
+
+    rng = np.random.default_rng(0)
+    ys = [rng.integers(0, 255, (16, 16), dtype=np.uint8) for _ in range(40)]
+    ys[20] = ys[19].copy()  # the first frame after the jump repeats the last one before it
+    frames = [Frame(i, i / 30 + JUMP * (i >= 20), Planes(ys[i], None, None, kind="gray"),
+                    gap=(JUMP + 1 / 30) * (i == 20)) for i in range(40)]
+    kept = list(RepeatFilter(SimpleNamespace(frames=lambda: iter(frames))).frames())
+    assert len(kept) == 39 and [f.index for f in kept if f.gap] == [21]
+    assert [f.gap for f in kept if f.gap] == [pytest.approx(JUMP + 2 / 30)]
