@@ -373,3 +373,69 @@ def test_a_repeat_left_out_after_a_jump_hands_its_gap_on():
     kept = list(RepeatFilter(SimpleNamespace(frames=lambda: iter(frames))).frames())
     assert len(kept) == 39 and [f.index for f in kept if f.gap] == [21]
     assert [f.gap for f in kept if f.gap] == [pytest.approx(JUMP + 2 / 30)]
+
+
+# ------------------------------------------------------------------- 1: a stalled stdin
+def _stalled(args, head: bytes = b""):
+    """wallcli reading a stdin that sends ``head`` and then nothing (the writer stays open)."""
+    import subprocess
+    import sys
+
+    p = subprocess.Popen([sys.executable, "-m", "wallcli", *map(str, args)], stdin=subprocess.PIPE,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    if head:
+        p.stdin.write(head)
+        p.stdin.flush()
+    return p
+
+
+def _finish(p, timeout):
+    """(exit code, stderr) once ``p`` ends, its stdin still open (no EOF to end it); killed and
+    None if it outlives ``timeout``."""
+    import subprocess
+
+    try:
+        p.wait(timeout=timeout)
+        return p.returncode, p.stderr.read().decode()
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+        return None, "still running"
+    finally:
+        p.stdin.close()
+        p.stdout.close()
+        p.stderr.close()
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("args,head", [(["count", "-", "--json"], 0), (["count", "-", "--follow"], 30_000)])
+def test_a_signal_ends_a_command_whose_stdin_stalled(mkv, sig, args, head):
+    import signal
+    import time
+
+    p = _stalled(args, mkv.read_bytes()[:head])
+    try:
+        time.sleep(6)  # started, its handlers installed, waiting on the silent pipe
+        assert p.poll() is None, p.communicate()
+        p.send_signal(getattr(signal, sig))
+        code, err = _finish(p, 20)  # the wait is in steps of 0.2 s: far less than 20
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert code == 1 and err.strip() == "Error: interrupted", (code, err)
+
+
+@pytest.mark.parametrize("args,head", [(["count", "-", "--json"], 0), (["stplot", "-", "--json"], 30_000)])
+def test_a_stalled_stdin_says_so_after_the_stall_timeout(mkv, args, head):
+    p = _stalled([*args, "--stall-timeout", "2"], mkv.read_bytes()[:head])
+    code, err = _finish(p, 60)
+    assert code == 1 and _one_line(err) and len(err.splitlines()) == 1, (code, err)
+    assert "Error: -: no data for 2 s (its writer stalled)" in err and "--stall-timeout" in err
+
+
+def test_stall_timeout_is_said_in_help(run_cli):
+    for command in ("count", "activity", "snr", "stplot", "amplify", "report"):
+        code, out, _ = run_cli(command, "--help")
+        text = " ".join(out.split())
+        assert code == 0 and "--stall-timeout" in text and "Default: 30, or for ever with --follow" in text

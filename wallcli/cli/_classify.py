@@ -41,11 +41,11 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
         no_shake: bool = False, stream: Optional[int] = None, activity_model: Optional[Path] = None,
-        single_stage: bool = False) -> None:
+        single_stage: bool = False, stall_timeout: Optional[float] = None) -> None:
     from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout, live=follow)
     roi_t = parse_roi(roi)
     fixes = corrections_of(no_deflicker, no_exposure, no_shake)
     if follow and plot is not None:

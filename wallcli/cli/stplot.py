@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import stream_option, PNG_NAME, ROI_HELP, check_png_names, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, stall_option, PNG_NAME, ROI_HELP, check_png_names, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
@@ -27,6 +27,7 @@ def stplot(
     force: bool = typer.Option(False, "--force", help=force_help("the -o and --png files")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
     64 positions x time x RGB) and over columns (vertical plot).
@@ -43,7 +44,7 @@ def stplot(
     """
     from wallcli.cli.common import use_stream
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout)
     from wallcli.errors import UsageError
 
     if output is None and png is None and not json_out:
