@@ -439,3 +439,39 @@ def test_stall_timeout_is_said_in_help(run_cli):
         code, out, _ = run_cli(command, "--help")
         text = " ".join(out.split())
         assert code == 0 and "--stall-timeout" in text and "Default: 30, or for ever with --follow" in text
+
+
+# ------------------------------------------------------------------- 9: stplot's memory
+def _stplot_peak(clip: Path, out: Path) -> tuple[int, int]:
+    """(tracemalloc peak of stplot's work on ``clip`` as the command does it, the plot's bytes)."""
+    import tracemalloc
+
+    from wallcli.io.arrays import save_npz
+    from wallcli.io.video import FrameTee, open_video
+    from wallcli.signal.pipeline import CameraPipeline
+    from wallcli.signal.stplot import channel_std, compute_stplot, to_arrays
+    from wallcli.signal.view import ViewCheck
+
+    tracemalloc.start()
+    try:
+        check = ViewCheck(None)
+        with open_video(clip) as reader:
+            plot = compute_stplot(FrameTee(CameraPipeline(reader, check), (check,)), register=True, view=check)
+        save_npz(out, *to_arrays(plot), force=True)
+        channel_std(plot.horizontal)  # (the --json summary)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    arrays = to_arrays(plot)[0]
+    return peak, sum(arrays[k].nbytes for k in ("horizontal", "vertical", "time", "shift"))
+
+
+def test_stplot_memory_grows_only_by_the_plot(tmp_path):
+    """Issue 47 item 9: 9.8 KB a frame at 720p (float64 copies of the whole plot at its end)."""
+    rng = np.random.default_rng(0)
+    clips = {n: write_clip(tmp_path / f"{n}.mkv", lambda i: np.full((48, 64, 3), 100.0) + rng.normal(0, 2, (48, 64, 3)),
+                           n) for n in (60, 300, 1200)}
+    _stplot_peak(clips[60], tmp_path / "w.npz")  # imports and first-use caches, outside the measure
+    (p1, b1), (p4, b4) = (_stplot_peak(clips[n], tmp_path / f"{n}.npz") for n in (300, 1200))
+    per_frame, plot_per_frame = (p4 - p1) / 900, (b4 - b1) / 900  # 1552 B: 2 x 64 bins x 3 colours float32 + 16
+    assert per_frame <= 1.1 * plot_per_frame, (per_frame, plot_per_frame)

@@ -111,7 +111,7 @@ def check_summary(meta: dict) -> dict | None:
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:
     from wallcli.cli.output import emit_json
     from wallcli.io.arrays import save_npz
-    from wallcli.signal.stplot import to_arrays
+    from wallcli.signal.stplot import channel_std, to_arrays
 
     if output is not None:
         save_npz(output, *to_arrays(plot), force=force)
@@ -125,7 +125,7 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
             "input": input, "output": str(output) if output else None, "png": str(png) if png else None,
             "frames": plot.frames, "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
             "fps_source": m.get("fps_source", "container"), "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
-            "signal_rms": [float(x) for x in plot.horizontal.std(axis=(0, 1))],
+            "signal_rms": [float(x) for x in channel_std(plot.horizontal)],
             "warnings": m.get("warnings", []),
             "view": check_summary(m),
         })
