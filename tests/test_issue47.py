@@ -475,3 +475,47 @@ def test_stplot_memory_grows_only_by_the_plot(tmp_path):
     (p1, b1), (p4, b4) = (_stplot_peak(clips[n], tmp_path / f"{n}.npz") for n in (300, 1200))
     per_frame, plot_per_frame = (p4 - p1) / 900, (b4 - b1) / 900  # 1552 B: 2 x 64 bins x 3 colours float32 + 16
     assert per_frame <= 1.1 * plot_per_frame, (per_frame, plot_per_frame)
+
+
+# ------------------------------------------------------------------- 3: --follow on a growing file
+def test_follow_reads_a_file_as_a_recorder_writes_it(tmp_path):
+    """Issue 47 item 3: --follow stopped at the current end of a file still being written."""
+    import threading
+    import time
+
+    rng = np.random.default_rng(0)
+    whole = write_clip(tmp_path / "whole.ts", lambda i: np.full((48, 64, 3), 100.0) + rng.normal(0, 2, (48, 64, 3)),
+                       600, fmt="mpegts").read_bytes()
+    growing = tmp_path / "rec.ts"
+    growing.write_bytes(whole[:len(whole) // 10])  # a tenth: 2 s of 20, less than one window
+    stop = threading.Event()
+
+    def record():  # the rest in 20 pieces, 0.3 s apart (well under the 5 s --idle-timeout)
+        rest = whole[len(whole) // 10:]
+        with open(growing, "ab") as f:
+            for i in range(20):
+                if stop.wait(0.3):
+                    return
+                f.write(rest[i * len(rest) // 20:(i + 1) * len(rest) // 20])
+                f.flush()
+
+    t = threading.Thread(target=record, daemon=True)
+    start = time.monotonic()
+    t.start()
+    try:
+        p = _cli(["count", growing, "--follow"], timeout=120)
+    finally:
+        stop.set()
+        t.join(10)
+    assert p.returncode == 0 and "truncated" not in p.stderr, p.stderr
+    windows = [json.loads(s) for s in p.stdout.splitlines()]
+    assert len(windows) == 6 and windows[-1]["start"] == pytest.approx(10.667, abs=0.01)  # 20 s: every stride
+    assert time.monotonic() - start >= 6 + 5 - 1  # it waited for the recorder, then for --idle-timeout
+    code = _cli(["count", tmp_path / "whole.ts", "--follow", "--idle-timeout", "0"], timeout=120)
+    assert [json.loads(s)["start"] for s in code.stdout.splitlines()] == [w["start"] for w in windows]
+
+
+def test_idle_timeout_is_said_in_help(run_cli):
+    for command in ("count", "activity"):
+        code, out, _ = run_cli(command, "--help")
+        assert code == 0 and "keep reading it as a recorder writes it" in " ".join(out.split())

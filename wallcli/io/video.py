@@ -42,6 +42,9 @@ STREAM: ContextVar[int | None] = ContextVar("wallcli_stream", default=None)
 DEFAULT_STALL = 30.0
 STALL: ContextVar[float | None] = ContextVar("wallcli_stall", default=DEFAULT_STALL)
 _POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal ends it within this)
+# --follow on a regular file: read it as it grows, until it has not grown for this many seconds
+# (None: read what is there, as any file)
+FOLLOW_IDLE: ContextVar[float | None] = ContextVar("wallcli_follow_idle", default=None)
 
 
 _QUEUE_SIZE = 8
@@ -135,8 +138,9 @@ class StreamInput:
     Python, in steps of _POLL, and fails with one line after ``stall`` seconds without data. Memory:
     at most 64 chunks of 64 KiB queued."""
 
-    def __init__(self, source: str, path: str | None, stall: float | None) -> None:
+    def __init__(self, source: str, path: str | None, stall: float | None, idle: float | None = None) -> None:
         self.source, self.stall = source, stall
+        self.idle = idle  # a growing file: at its end, wait this long for more before calling it the end
         self.interrupted = False  # a signal arrived while FFmpeg read in the main thread
         self._q: queue.Queue = queue.Queue(maxsize=64)
         self._stop = threading.Event()
@@ -154,6 +158,8 @@ class StreamInput:
         try:
             while not self._stop.is_set():
                 chunk = os.read(fd, 1 << 16)
+                if not chunk and self.idle is not None and self._grows(fd):
+                    continue
                 self._put(chunk)
                 if not chunk:
                     break
@@ -161,6 +167,18 @@ class StreamInput:
             self._put(exc)
         finally:
             os.close(fd)
+
+    def _grows(self, fd: int) -> bool:
+        """At the end of a file being written: whether it grows within ``idle`` seconds."""
+        import time
+
+        end, waited = os.lseek(fd, 0, os.SEEK_CUR), 0.0
+        while not self._stop.is_set() and waited < self.idle:
+            if os.fstat(fd).st_size > end:
+                return True
+            time.sleep(_POLL)
+            waited += _POLL
+        return False
 
     def _put(self, item) -> None:
         while not self._stop.is_set():
@@ -238,8 +256,11 @@ class VideoReader:
         target = source
         fmt = input_format
         self._input = None
+        self.following = FOLLOW_IDLE.get() is not None and source != "-" and os.path.isfile(source)
         if source == "-" or _byte_stream(source):
             target = self._input = StreamInput(source, None if source == "-" else source, STALL.get())
+        elif self.following:  # a recording still being written: read as it grows (see StreamInput)
+            target = self._input = StreamInput(source, source, None, idle=FOLLOW_IDLE.get())
         elif _is_url(source):
             if source.startswith("rtsp://"):
                 options["rtsp_transport"] = "tcp"
@@ -512,8 +533,8 @@ class VideoReader:
 
     def _check_complete(self, decoded: int, last_time: float) -> None:
         """Warn when the file promised more frames or more time than it held (truncation)."""
-        if not decoded or self.source == "-" or _is_url(self.source):
-            return
+        if not decoded or self.source == "-" or _is_url(self.source) or self.following:
+            return  # (a followed file's header was written before its end)
         expected = self._declared_frames
         duration = self.info.duration
         if expected and decoded < 0.9 * expected - 1:
