@@ -315,3 +315,207 @@ def test_a_tiny_roi_is_too_small_to_check(mkv, run_cli):
     res = json.loads(out)
     assert res["view"]["usable"] is False and "too small to check" in res["view"]["issues"]
     assert res["confident"] is False
+
+
+# ------------------------------------------------------------------- 2: a jump of the timestamps
+JUMP = 10_000.0  # s, after frame 300 of 600 (30 fps): interpolated over, 300,000 rows and ~4,700 windows
+
+
+@pytest.fixture(scope="module")
+def jumpy(tmp_path_factory) -> Path:
+    from fractions import Fraction
+
+    rng = np.random.default_rng(0)
+    return write_clip(tmp_path_factory.mktemp("jump") / "j.mkv",
+                      lambda i: np.full((48, 64, 3), 100 + 5 * np.sin(i / 5)) + rng.normal(0, 2, (48, 64, 3)), 600,
+                      time_base=Fraction(1, 1000), pts_fn=lambda i: round((i / 30 + JUMP * (i >= 300)) * 1000))
+
+
+def _cli(args, timeout=120, **kw):
+    """wallcli in a child process, killed (by subprocess.run) if it outlives ``timeout``."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "wallcli", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout, **kw)
+
+
+@pytest.mark.parametrize("how", ["json", "follow", "npz"])
+def test_a_timestamp_jump_costs_nothing_and_no_window_sits_in_it(jumpy, tmp_path, how):
+    source = jumpy
+    if how == "npz":
+        source = tmp_path / "p.npz"
+        assert _cli(["stplot", jumpy, "-o", source]).returncode == 0
+    p = _cli(["count", source, "--follow" if how == "follow" else "--json"])
+    assert p.returncode == 0, p.stderr
+    windows = [json.loads(s) for s in p.stdout.splitlines()] if how == "follow" else json.loads(p.stdout)["windows"]
+    before = [w for w in windows if w["end"] <= 10.0 + 1e-3]
+    after = [w for w in windows if w["start"] >= JUMP + 10.0 - 1e-3]
+    assert before and after and len(before) + len(after) == len(windows) <= 4, [(w["start"], w["end"]) for w in windows]
+    # cut on either side of the gap, none spans it: the view check has no fault to find in them
+    assert all(w["view"]["usable"] for w in windows), [w["view"] for w in windows]
+
+
+def test_a_repeat_left_out_after_a_jump_hands_its_gap_on():
+    """The frame after a jump may copy the one before it (a recorder re-sending its last picture):
+    the repeat filter drops it, and the next frame must still restart the grid."""
+    from types import SimpleNamespace
+
+    from wallcli.io.planes import Planes
+    from wallcli.io.video import Frame
+    from wallcli.signal.repeats import RepeatFilter
+
+    rng = np.random.default_rng(0)
+    ys = [rng.integers(0, 255, (16, 16), dtype=np.uint8) for _ in range(40)]
+    ys[20] = ys[19].copy()  # the first frame after the jump repeats the last one before it
+    frames = [Frame(i, i / 30 + JUMP * (i >= 20), Planes(ys[i], None, None, kind="gray"),
+                    gap=(JUMP + 1 / 30) * (i == 20)) for i in range(40)]
+    kept = list(RepeatFilter(SimpleNamespace(frames=lambda: iter(frames))).frames())
+    assert len(kept) == 39 and [f.index for f in kept if f.gap] == [21]
+    assert [f.gap for f in kept if f.gap] == [pytest.approx(JUMP + 2 / 30)]
+
+
+# ------------------------------------------------------------------- 1: a stalled stdin
+def _stalled(args, head: bytes = b""):
+    """wallcli reading a stdin that sends ``head`` and then nothing (the writer stays open)."""
+    import subprocess
+    import sys
+
+    p = subprocess.Popen([sys.executable, "-m", "wallcli", *map(str, args)], stdin=subprocess.PIPE,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    if head:
+        p.stdin.write(head)
+        p.stdin.flush()
+    return p
+
+
+def _finish(p, timeout):
+    """(exit code, stderr) once ``p`` ends, its stdin still open (no EOF to end it); killed and
+    None if it outlives ``timeout``."""
+    import subprocess
+
+    try:
+        p.wait(timeout=timeout)
+        return p.returncode, p.stderr.read().decode()
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+        return None, "still running"
+    finally:
+        p.stdin.close()
+        p.stdout.close()
+        p.stderr.close()
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("args,head", [(["count", "-", "--json"], 0), (["count", "-", "--follow"], 30_000)])
+def test_a_signal_ends_a_command_whose_stdin_stalled(mkv, sig, args, head):
+    import signal
+    import time
+
+    p = _stalled(args, mkv.read_bytes()[:head])
+    try:
+        time.sleep(6)  # started, its handlers installed, waiting on the silent pipe
+        assert p.poll() is None, p.communicate()
+        p.send_signal(getattr(signal, sig))
+        code, err = _finish(p, 20)  # the wait is in steps of 0.2 s: far less than 20
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert code == 1 and err.strip() == "Error: interrupted", (code, err)
+
+
+@pytest.mark.parametrize("args,head", [(["count", "-", "--json"], 0), (["stplot", "-", "--json"], 30_000)])
+def test_a_stalled_stdin_says_so_after_the_stall_timeout(mkv, args, head):
+    p = _stalled([*args, "--stall-timeout", "2"], mkv.read_bytes()[:head])
+    code, err = _finish(p, 60)
+    assert code == 1 and _one_line(err) and len(err.splitlines()) == 1, (code, err)
+    assert "Error: -: no data for 2 s (its writer stalled)" in err and "--stall-timeout" in err
+
+
+def test_stall_timeout_is_said_in_help(run_cli):
+    for command in ("count", "activity", "snr", "stplot", "amplify", "report"):
+        code, out, _ = run_cli(command, "--help")
+        text = " ".join(out.split())
+        assert code == 0 and "--stall-timeout" in text and "Default: 30, or for ever with --follow" in text
+
+
+# ------------------------------------------------------------------- 9: stplot's memory
+def _stplot_peak(clip: Path, out: Path) -> tuple[int, int]:
+    """(tracemalloc peak of stplot's work on ``clip`` as the command does it, the plot's bytes)."""
+    import tracemalloc
+
+    from wallcli.io.arrays import save_npz
+    from wallcli.io.video import FrameTee, open_video
+    from wallcli.signal.pipeline import CameraPipeline
+    from wallcli.signal.stplot import channel_std, compute_stplot, to_arrays
+    from wallcli.signal.view import ViewCheck
+
+    tracemalloc.start()
+    try:
+        check = ViewCheck(None)
+        with open_video(clip) as reader:
+            plot = compute_stplot(FrameTee(CameraPipeline(reader, check), (check,)), register=True, view=check)
+        save_npz(out, *to_arrays(plot), force=True)
+        channel_std(plot.horizontal)  # (the --json summary)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    arrays = to_arrays(plot)[0]
+    return peak, sum(arrays[k].nbytes for k in ("horizontal", "vertical", "time", "shift"))
+
+
+def test_stplot_memory_grows_only_by_the_plot(tmp_path):
+    """Issue 47 item 9: 9.8 KB a frame at 720p (float64 copies of the whole plot at its end)."""
+    rng = np.random.default_rng(0)
+    clips = {n: write_clip(tmp_path / f"{n}.mkv", lambda i: np.full((48, 64, 3), 100.0) + rng.normal(0, 2, (48, 64, 3)),
+                           n) for n in (60, 300, 1200)}
+    _stplot_peak(clips[60], tmp_path / "w.npz")  # imports and first-use caches, outside the measure
+    (p1, b1), (p4, b4) = (_stplot_peak(clips[n], tmp_path / f"{n}.npz") for n in (300, 1200))
+    per_frame, plot_per_frame = (p4 - p1) / 900, (b4 - b1) / 900  # 1552 B: 2 x 64 bins x 3 colours float32 + 16
+    assert per_frame <= 1.1 * plot_per_frame, (per_frame, plot_per_frame)
+
+
+# ------------------------------------------------------------------- 3: --follow on a growing file
+def test_follow_reads_a_file_as_a_recorder_writes_it(tmp_path):
+    """Issue 47 item 3: --follow stopped at the current end of a file still being written."""
+    import threading
+    import time
+
+    rng = np.random.default_rng(0)
+    whole = write_clip(tmp_path / "whole.ts", lambda i: np.full((48, 64, 3), 100.0) + rng.normal(0, 2, (48, 64, 3)),
+                       600, fmt="mpegts").read_bytes()
+    growing = tmp_path / "rec.ts"
+    growing.write_bytes(whole[:len(whole) // 10])  # a tenth: 2 s of 20, less than one window
+    stop = threading.Event()
+
+    def record():  # the rest in 20 pieces, 0.3 s apart (well under the 5 s --idle-timeout)
+        rest = whole[len(whole) // 10:]
+        with open(growing, "ab") as f:
+            for i in range(20):
+                if stop.wait(0.3):
+                    return
+                f.write(rest[i * len(rest) // 20:(i + 1) * len(rest) // 20])
+                f.flush()
+
+    t = threading.Thread(target=record, daemon=True)
+    start = time.monotonic()
+    t.start()
+    try:
+        p = _cli(["count", growing, "--follow"], timeout=120)
+    finally:
+        stop.set()
+        t.join(10)
+    assert p.returncode == 0 and "truncated" not in p.stderr, p.stderr
+    windows = [json.loads(s) for s in p.stdout.splitlines()]
+    assert len(windows) == 6 and windows[-1]["start"] == pytest.approx(10.667, abs=0.01)  # 20 s: every stride
+    assert time.monotonic() - start >= 6 + 5 - 1  # it waited for the recorder, then for --idle-timeout
+    code = _cli(["count", tmp_path / "whole.ts", "--follow", "--idle-timeout", "0"], timeout=120)
+    assert [json.loads(s)["start"] for s in code.stdout.splitlines()] == [w["start"] for w in windows]
+
+
+def test_idle_timeout_is_said_in_help(run_cli):
+    for command in ("count", "activity"):
+        code, out, _ = run_cli(command, "--help")
+        assert code == 0 and "keep reading it as a recorder writes it" in " ".join(out.split())

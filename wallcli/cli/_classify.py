@@ -32,6 +32,9 @@ VERBOSE_OPT = typer.Option(False, "--verbose", "-v", help="Also print, on stderr
                            "each window's reason is. Without it: the table and one line saying why the answer is "
                            "decided or not.")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
+IDLE_OPT = number_option(5.0, "--idle-timeout", lo=0, hi=1e6,
+                         help="With --follow on a file: keep reading it as a recorder writes it, and end when it "
+                              "has not grown for this many seconds.")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
 FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
 INPUT_ARG = input_argument(INPUT_HELP)
@@ -45,11 +48,16 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         model_path: Optional[Path], threads: int, follow: bool, roi: Optional[str], force: bool,
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
         no_shake: bool = False, stream: Optional[int] = None, activity_model: Optional[Path] = None,
-        single_stage: bool = False, verbose: bool = False) -> None:
+        single_stage: bool = False, verbose: bool = False, stall_timeout: Optional[float] = None,
+        idle_timeout: float = 5.0) -> None:
     from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout, live=follow)
+    if follow:
+        from wallcli.io.video import FOLLOW_IDLE
+
+        FOLLOW_IDLE.set(float(idle_timeout))
     roi_t = parse_roi(roi)
     fixes = corrections_of(no_deflicker, no_exposure, no_shake)
     if follow and plot is not None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
-from wallcli.cli.common import stream_option
-from wallcli.cli._classify import (FOLLOW_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
+from wallcli.cli.common import stream_option, stall_option
+from wallcli.cli._classify import (FOLLOW_OPT, IDLE_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT, MODEL_OPT, PLOT_OPT, ROI_OPT,
                                    STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT,
                                    VERBOSE_OPT, run)
 
@@ -18,7 +18,9 @@ def activity(
     model: Optional[Path] = MODEL_OPT,
     threads: int = THREADS_OPT,
     stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
     follow: bool = FOLLOW_OPT,
+    idle_timeout: float = IDLE_OPT,
     roi: Optional[str] = ROI_OPT,
     force: bool = FORCE_OPT,
     strict: bool = STRICT_OPT,
@@ -47,4 +49,5 @@ def activity(
     """
     run("activity", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,
-        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake, stream=stream, verbose=verbose)
+        no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake, stream=stream, verbose=verbose,
+        stall_timeout=stall_timeout, idle_timeout=idle_timeout)

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import stream_option, ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, stall_option, ROI_HELP, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # Frames held back while the automatic gain calibrates are kept whole only with --side-by-side
@@ -65,6 +65,7 @@ def amplify(
     force: bool = typer.Option(False, "--force", help=force_help("OUTPUT")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
 ) -> None:
     """Make the invisible visible: a video of the wall's tiny light changes, amplified.
 
@@ -81,7 +82,7 @@ def amplify(
     """
     from wallcli.cli.common import use_stream
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout)
     from wallcli.errors import UsageError
 
     if mean not in ("ema", "window"):

@@ -132,10 +132,13 @@ def main(argv: list[str] | None = None) -> None:
 
 
 def _forget_stream() -> None:
-    """--stream is one command's choice: never the next one's, nor a library caller's after it."""
+    """--stream, --stall-timeout and --follow's --idle-timeout are one command's choice: never the next one's, nor a library
+    caller's after it."""
     video = sys.modules.get("wallcli.io.video")
     if video is not None:
         video.STREAM.set(None)
+        video.STALL.set(video.DEFAULT_STALL)
+        video.FOLLOW_IDLE.set(None)
 
 
 def _run(argv: list[str] | None) -> int:

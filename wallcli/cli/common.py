@@ -134,11 +134,23 @@ def stream_option():
                               "says which was read.")
 
 
-def use_stream(index) -> None:
-    """Make ``index`` (--stream) the stream every reader of this command opens."""
-    from wallcli.io.video import STREAM
+def stall_option():
+    """``--stall-timeout SECONDS``: how long stdin or a FIFO may send nothing."""
+    return number_option(None, "--stall-timeout", lo=0, hi=1e6,
+                         help="Seconds stdin or a pipe may send nothing before the command stops with an "
+                              "error saying it stalled; 0 waits for ever. Default: 30, or for ever with "
+                              "--follow (a live feed may pause). Ctrl-C ends the wait at any time.")
+
+
+def use_stream(index, stall: float | None = None, *, live: bool = False) -> None:
+    """Make ``index`` (--stream) the stream every reader of this command opens, and ``stall``
+    (--stall-timeout; None: the default, for ever when ``live``) how long its input may stall."""
+    from wallcli.io.video import DEFAULT_STALL, STALL, STREAM
 
     STREAM.set(index)
+    if stall is None:
+        stall = 0 if live else DEFAULT_STALL
+    STALL.set(float(stall) or None)
 
 
 STRICT_HELP = ("Exit 1 when the view check finds the video is not a static view of a wall (camera motion, "

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (stream_option, ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (stream_option, stall_option, ROI_HELP, THREADS_HELP, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 parse_roi, refuse_view, strict_option, threads_option)
 
 RESULTS_SUFFIXES = (".jsonl", ".ndjson")
@@ -34,6 +34,7 @@ def report(
     force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
@@ -66,7 +67,7 @@ def report(
     """
     from wallcli.cli.common import use_stream
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout)
     from wallcli.errors import UsageError
 
     if output.suffix.lower() not in (".html", ".htm"):

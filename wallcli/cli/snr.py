@@ -8,7 +8,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import (stream_option, PNG_NAME, THREADS_HELP, check_png_names, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
+from wallcli.cli.common import (stream_option, stall_option, PNG_NAME, THREADS_HELP, check_png_names, Number, corrections_of, deflicker_option, exposure_option, shake_option, force_help,
                                 number_option, strict_option, threads_option)
 
 # Parameters of --predict, by the name --sweep uses: (option, default, help, range). The range
@@ -79,6 +79,7 @@ def snr(
     force: bool = typer.Option(False, "--force", help=force_help("the --heatmap and --plot files")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),
@@ -102,7 +103,7 @@ def snr(
     """
     from wallcli.cli.common import use_stream
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout)
     from wallcli.errors import UsageError
     from wallcli.io.writer import committed_together
 

@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 
-from wallcli.cli.common import stream_option, PNG_NAME, ROI_HELP, check_png_names, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
+from wallcli.cli.common import stream_option, stall_option, PNG_NAME, ROI_HELP, check_png_names, THREADS_HELP, force_help, input_argument, number_option, parse_roi, threads_option
 
 
 def stplot(
@@ -27,6 +27,7 @@ def stplot(
     force: bool = typer.Option(False, "--force", help=force_help("the -o and --png files")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
     64 positions x time x RGB) and over columns (vertical plot).
@@ -43,7 +44,7 @@ def stplot(
     """
     from wallcli.cli.common import use_stream
 
-    use_stream(stream)
+    use_stream(stream, stall_timeout)
     from wallcli.errors import UsageError
 
     if output is None and png is None and not json_out:
@@ -110,7 +111,7 @@ def check_summary(meta: dict) -> dict | None:
 def _write(plot, input, output, png, style, gain, json_out, force) -> None:
     from wallcli.cli.output import emit_json
     from wallcli.io.arrays import save_npz
-    from wallcli.signal.stplot import to_arrays
+    from wallcli.signal.stplot import channel_std, to_arrays
 
     if output is not None:
         save_npz(output, *to_arrays(plot), force=force)
@@ -124,7 +125,7 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
             "input": input, "output": str(output) if output else None, "png": str(png) if png else None,
             "frames": plot.frames, "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
             "fps_source": m.get("fps_source", "container"), "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
-            "signal_rms": [float(x) for x in plot.horizontal.std(axis=(0, 1))],
+            "signal_rms": [float(x) for x in channel_std(plot.horizontal)],
             "warnings": m.get("warnings", []),
             "view": check_summary(m),
         })

@@ -19,7 +19,7 @@ import numpy as np
 from wallcli.errors import WallcliError
 from wallcli.infer.confidence import judge
 from wallcli.signal import corrections as corr
-from wallcli.signal.window import StreamWindower, resample, window_signal_db, window_starts
+from wallcli.signal.window import StreamWindower, resample, run_window_starts, window_signal_db
 
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
 
@@ -177,8 +177,7 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
         shifts = resample(ext, plot.time, model.fps)[0][0, :, :2].astype(np.float64)
     # the plot is its clip mean removed; that mean is the level offset normalisation v3 needs
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
-    frames = len(grid) if plot.frames >= 2 else plot.frames
-    starts = window_starts(frames, model.window, stride)
+    starts = run_window_starts(grid, model.fps, model.window, stride)  # none spans a gap
     if not starts:
         raise _too_short(source, plot.frames, model, native_fps(plot.time))
     probs, signal, found = [], [], []
@@ -242,10 +241,9 @@ class WindowClassifier:
     def __init__(self, model, stride: int, *, corrections: corr.Options = corr.Options(), native_fps=None):
         self.model, self.stride = model, int(stride)
         self.corrections, self.native_fps = corrections, native_fps  # native_fps: the video's own rate
-        self.windower = StreamWindower(model.window, stride)
+        self.windower = StreamWindower(model.window, stride, model.fps)
         self.times, self.probs, self.signal, self.found = [], [], [], []
         self.ref = None
-        self._emitted = 0  # rows seen when the newest window was classified
 
     def push(self, t: float, row: np.ndarray, ref: np.ndarray) -> None:
         self.ref = ref
@@ -257,18 +255,22 @@ class WindowClassifier:
             self.probs.append(p)
             self.signal.append(db)
             self.found.append(f)
-            self._emitted = self.windower.count
+
+    @property
+    def empty(self) -> bool:
+        """No window so far, nor one at the end: the stream is too short to answer."""
+        return not self.times and self.windower.pending() is None
 
     def result(self, source: str, frames: int | None = None) -> dict[str, Any]:
         """The docs/contract.md result; WallcliError when the stream was shorter than one window
         (quoting ``frames``, the video's decoded frames, where given)."""
         model, w = self.model, self.windower
-        last = w.last()
-        if last is None:
+        last = w.pending()
+        if self.empty:
             raise _too_short(str(source), w.count if frames is None else frames, model,
                              None if frames is None else self.native_fps)
         times, probs, signal, found = list(self.times), list(self.probs), list(self.signal), list(self.found)
-        if self._emitted != w.count:  # window_starts' end-aligned window: the last `window` rows
+        if last is not None:  # window_starts' end-aligned window: the last `window` rows
             p, db, f = _predict_window(model, last[2], self.ref, start=last[0], native=self.native_fps,
                                        options=self.corrections)
             times.append(last[0])
@@ -332,7 +334,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
             if thumb is not None:
                 thumb.push(t, row)
             classifier.push(t, stream_row(row, rows), rows.ref)
-        if classifier.windower.last() is None:
+        if classifier.empty:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)
     result = with_view(classifier.result(str(source), frames=unique.decoded), check)
@@ -409,7 +411,7 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
                 rec |= {"corrections": corr.merge([classifier.found[-1]])}
                 # what the frames so far say of the noise (a window holds 256 of them)
                 yield bound_result(judge_view(rec, check.view(rec["start"], rec["end"])), blend.correction())
-        if classifier.windower.last() is None:
+        if classifier.empty:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)
     result = with_view(classifier.result(str(source), frames=unique.decoded), check)

@@ -9,7 +9,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from wallcli.signal.window import StreamResampler
+from wallcli.signal.window import MAX_BRIDGE, StreamResampler
 
 
 class RowStream:
@@ -53,6 +53,8 @@ class RowStream:
                 reduce = RowReducer(self.roi, self.bins, self.vertical, self.stabilize, self.register)
                 self.shifts = reduce.shifts
             row = np.concatenate(reduce(frame.planes))
+            if getattr(frame, "gap", 0.0) > MAX_BRIDGE:  # frames lost: a new grid from here, nothing invented inside
+                resampler.restart()
             if self.ref is None:
                 self.ref = row
             self.frames += 1

@@ -24,8 +24,26 @@ def save_npz(path: str | os.PathLike, arrays: dict[str, np.ndarray], meta: dict,
             raise TypeError(f"array {k!r} has dtype object; it would need pickle")
     payload[META_KEY] = np.array(json.dumps(meta))
     with atomic_path(path, force=force) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, **payload)
+        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:  # as np.savez writes
+            for k, v in payload.items():
+                with zf.open(k + ".npy", "w", force_zip64=True) as fid:
+                    _write_npy(fid, v)
+
+
+def _write_npy(fid, a: np.ndarray, step_bytes: int = 1 << 20) -> None:
+    """One .npy member, its data in C order a slab of about ``step_bytes`` at a time: np.savez
+    copies a whole array (chunk.tobytes) to write it, a second plot's worth of memory."""
+    from numpy.lib import format as npy
+
+    header = npy.header_data_from_array_1_0(a)
+    header["fortran_order"] = False  # the slabs below are written in C order, whatever a's layout
+    npy.write_array_header_1_0(fid, header)
+    if a.ndim == 0:
+        fid.write(a.tobytes())
+        return
+    step = max(1, step_bytes // max(1, a[:1].nbytes))
+    for i in range(0, a.shape[0], step):
+        fid.write(np.ascontiguousarray(a[i:i + step]).data)
 
 
 def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[str, np.ndarray], dict]:

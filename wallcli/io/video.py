@@ -37,6 +37,15 @@ STDIN_MP4 = ("-: an MP4 cannot be streamed on stdin (its index is at the end of 
 # --stream N (cli.common.use_stream); None: the first real video stream
 STREAM: ContextVar[int | None] = ContextVar("wallcli_stream", default=None)
 
+# How long a byte stream (stdin, a FIFO, <(...)) may send nothing before the read fails saying so,
+# for commands given --stall-timeout (cli.common.use_stream); None: wait for ever (a live feed)
+DEFAULT_STALL = 30.0
+STALL: ContextVar[float | None] = ContextVar("wallcli_stall", default=DEFAULT_STALL)
+_POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal ends it within this)
+# --follow on a regular file: read it as it grows, until it has not grown for this many seconds
+# (None: read what is there, as any file)
+FOLLOW_IDLE: ContextVar[float | None] = ContextVar("wallcli_follow_idle", default=None)
+
 
 _QUEUE_SIZE = 8
 
@@ -114,7 +123,7 @@ class NotAVideo(WallcliError):
 
 
 def _describe_open_error(source: str, exc: Exception) -> WallcliError:
-    text = str(exc)
+    text = str(exc).replace(": '<none>'", "")  # (PyAV's name for a stream it reads from Python)
     if isinstance(exc, FileNotFoundError) or "No such file" in text:
         return WallcliError(f"no such file: {source}")
     if "Permission denied" in text:
@@ -129,6 +138,124 @@ def _is_url(source: str) -> bool:
     return re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*://", source) is not None
 
 
+class _Stopped(Exception):
+    """The read was stopped (the reader closed, or a signal in the main thread): an Exception, so
+    that PyAV hands it back where FFmpeg returns instead of dropping it."""
+
+
+class StreamInput:
+    """A byte stream (stdin, a FIFO) read by a thread of ours and handed to FFmpeg as a Python file.
+
+    FFmpeg's own read() of a pipe blocks in C, where neither Ctrl-C, SIGTERM nor the decoder's stop
+    reach it (a stalled writer held wallcli for as long as it stalled); here every wait is in
+    Python, in steps of _POLL, and fails with one line after ``stall`` seconds without data. Memory:
+    at most 64 chunks of 64 KiB queued."""
+
+    def __init__(self, source: str, path: str | None, stall: float | None, idle: float | None = None) -> None:
+        self.source, self.stall = source, stall
+        self.idle = idle  # a growing file: at its end, wait this long for more before calling it the end
+        self.interrupted = False  # a signal arrived while FFmpeg read in the main thread
+        self._q: queue.Queue = queue.Queue(maxsize=64)
+        self._stop = threading.Event()
+        self._buf = b""
+        self._done = False  # EOF given, or the read failed once (FFmpeg may ask again: say EOF)
+        threading.Thread(target=self._pump, args=(path,), daemon=True, name="wallcli-input").start()
+
+    def _pump(self, path: str | None) -> None:
+        # (opening a FIFO blocks until its writer opens it: here, not in the main thread). The
+        # thread may stay in os.read when the command ends: a daemon, holding nothing of FFmpeg's.
+        try:
+            fd = os.dup(0) if path is None else os.open(path, os.O_RDONLY)
+        except OSError as exc:
+            return self._put(exc)
+        try:
+            while not self._stop.is_set():
+                chunk = os.read(fd, 1 << 16)
+                if not chunk and self.idle is not None and self._grows(fd):
+                    continue
+                self._put(chunk)
+                if not chunk:
+                    break
+        except OSError as exc:
+            self._put(exc)
+        finally:
+            os.close(fd)
+
+    def _grows(self, fd: int) -> bool:
+        """At the end of a file being written: whether it grows within ``idle`` seconds."""
+        import time
+
+        end, waited = os.lseek(fd, 0, os.SEEK_CUR), 0.0
+        while not self._stop.is_set() and waited < self.idle:
+            if os.fstat(fd).st_size > end:
+                return True
+            time.sleep(_POLL)
+            waited += _POLL
+        return False
+
+    def _put(self, item) -> None:
+        while not self._stop.is_set():
+            try:
+                return self._q.put(item, timeout=_POLL)
+            except queue.Full:
+                pass
+
+    def read(self, n: int) -> bytes:
+        try:
+            return self._read(int(n))
+        except KeyboardInterrupt:  # the signal handler's raise, inside FFmpeg's call of read()
+            self.interrupted = True
+            self._done = True
+            raise _Stopped("interrupted") from None
+        except BaseException:
+            self._done = True
+            raise
+
+    def _read(self, n: int) -> bytes:
+        if not self._buf:
+            if self._done:
+                return b""
+            import time
+
+            waited = 0.0
+            while True:
+                if self._stop.is_set():
+                    raise _Stopped("stopped")
+                t = time.monotonic()
+                try:
+                    item = self._q.get(timeout=_POLL)
+                    break
+                except queue.Empty:
+                    waited += time.monotonic() - t
+                    if self.stall is not None and waited >= self.stall:
+                        raise WallcliError(f"{self.source}: no data for {self.stall:g} s (its writer stalled)",
+                                           hint="--stall-timeout SECONDS waits longer; 0, for ever")
+            if isinstance(item, OSError):
+                raise WallcliError(f"cannot read {self.source}: {item.strerror or item}")
+            if not item:
+                self._done = True
+                return b""
+            self._buf = item
+        out, self._buf = self._buf[:n], self._buf[n:]
+        return out
+
+    def close(self) -> None:
+        self._stop.set()
+
+
+def _byte_stream(source: str) -> bool:
+    """A path that is a pipe, socket or character device (not a camera): read as a stream."""
+    import stat
+
+    if source.startswith("/dev/video"):
+        return False
+    try:
+        mode = os.stat(source).st_mode
+    except OSError:
+        return False
+    return stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode) or stat.S_ISCHR(mode)
+
+
 class VideoReader:
     """Open with :func:`open_video`; iterate :meth:`frames` once (decode once, stream)."""
 
@@ -141,8 +268,12 @@ class VideoReader:
         options: dict[str, str] = {}
         target = source
         fmt = input_format
-        if source == "-":
-            target = "pipe:0"
+        self._input = None
+        self.following = FOLLOW_IDLE.get() is not None and source != "-" and os.path.isfile(source)
+        if source == "-" or _byte_stream(source):
+            target = self._input = StreamInput(source, None if source == "-" else source, STALL.get())
+        elif self.following:  # a recording still being written: read as it grows (see StreamInput)
+            target = self._input = StreamInput(source, source, None, idle=FOLLOW_IDLE.get())
         elif _is_url(source):
             if source.startswith("rtsp://"):
                 options["rtsp_transport"] = "tcp"
@@ -163,8 +294,18 @@ class VideoReader:
                 raise WallcliError(f"{source} is empty (0 bytes)")
         try:
             self._container = av.open(target, mode="r", format=fmt, options=options, timeout=30.0)
-        except (av.error.FFmpegError, OSError, ValueError) as exc:
+        except (av.error.FFmpegError, OSError, ValueError, _Stopped) as exc:
+            if self._input is not None:
+                self._input.close()
+                if self._input.interrupted:
+                    from wallcli.errors import Interrupted
+
+                    raise Interrupted from None
             raise _describe_open_error(source, exc) from None
+        except BaseException:
+            if self._input is not None:
+                self._input.close()
+            raise
         if not self._container.streams.video:
             self._container.close()
             raise NotAVideo(f"{source} has no video stream", "it has no video stream")
@@ -309,7 +450,7 @@ class VideoReader:
                     q.put(("frame", frame))
                     if stop.is_set():
                         break
-        except av.error.EOFError:
+        except (av.error.EOFError, _Stopped):
             pass
         except (av.error.FFmpegError, OSError) as exc:
             q.put(("damage", str(exc).strip() or type(exc).__name__))
@@ -405,8 +546,8 @@ class VideoReader:
 
     def _check_complete(self, decoded: int, last_time: float) -> None:
         """Warn when the file promised more frames or more time than it held (truncation)."""
-        if not decoded or self.source == "-" or _is_url(self.source):
-            return
+        if not decoded or self.source == "-" or _is_url(self.source) or self.following:
+            return  # (a followed file's header was written before its end)
         expected = self._declared_frames
         duration = self.info.duration
         if expected and decoded < 0.9 * expected - 1:
@@ -429,6 +570,8 @@ class VideoReader:
             return
         thread, q, stop = worker
         stop.set()
+        if self._input is not None:
+            self._input.close()  # the decoder may wait in its read()
         while thread.is_alive():
             try:  # unblock the producer if it waits on a full queue
                 q.get_nowait()
@@ -438,6 +581,8 @@ class VideoReader:
 
     def close(self) -> None:
         self._stop_worker()
+        if self._input is not None:
+            self._input.close()
         if self._container is not None:
             self._container.close()
             self._container = None

@@ -57,3 +57,20 @@ def remove_mean(rows: np.ndarray, times: np.ndarray, mode: str = "clip", seconds
     for i, (t, r) in enumerate(zip(times, rows)):
         out[i] = r - rm.update(float(t), r)
     return out
+
+
+def remove_mean_in_place(rows: np.ndarray, times: np.ndarray, mode: str = "clip", seconds: float = 10.0,
+                         chunk: int = 128) -> np.ndarray:
+    """:func:`remove_mean` written over ``rows`` (float32, time along axis 0), a ``chunk`` of rows
+    at a time: the same values, without a second (or float64) copy of a long plot. Returns the
+    clip mean (float64) of the rows as they were."""
+    clip = rows.mean(axis=0, dtype=np.float64)
+    if mode == "clip":
+        for i in range(0, rows.shape[0], chunk):
+            rows[i:i + chunk] = rows[i:i + chunk] - clip  # in float64, rounded once, as remove_mean
+        return clip
+    rm = RunningMean(mode, seconds)
+    for i, t in enumerate(times):
+        r = rows[i].astype(np.float64)
+        rows[i] = r - rm.update(float(t), r)
+    return clip

@@ -50,6 +50,8 @@ class RepeatFilter:
         self.last_time = 0.0  # of the last frame decoded, a repeat or not
         self._prev = None
         self._recent: deque = deque(maxlen=HISTORY)
+        self._kept = None  # time of the last frame passed on
+        self._lost_gap = False  # a repeat left out came after a jump of the timestamps
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
@@ -81,9 +83,9 @@ class RepeatFilter:
             d = self._difference(frame.planes.y)
             if waiting is None:
                 if self._judge(d):
-                    self.repeats += 1
+                    self._drop(frame)
                     continue
-                yield frame
+                yield self._pass(frame)
                 continue
             waiting.append((frame, d))
             if d:
@@ -98,9 +100,24 @@ class RepeatFilter:
         typical = float(np.median(self._recent)) if len(self._recent) >= MIN_HISTORY else None
         for frame, d in waiting:
             if typical is not None and d is not None and d < REL * typical:
-                self.repeats += 1
+                self._drop(frame)
                 continue
-            yield frame
+            yield self._pass(frame)
+
+    def _drop(self, frame) -> None:
+        self.repeats += 1
+        self._lost_gap = self._lost_gap or bool(getattr(frame, "gap", 0.0))
+
+    def _pass(self, frame):
+        """``frame``, carrying the gap of a repeat left out before it: the resampling restarts at
+        a gap and the view check marks it, whichever frame after it they see first."""
+        if self._lost_gap and not getattr(frame, "gap", 0.0) and self._kept is not None:
+            import dataclasses
+
+            frame = dataclasses.replace(frame, gap=frame.time - self._kept)
+        self._lost_gap = False
+        self._kept = frame.time
+        return frame
 
     def correction(self) -> dict | None:
         """The ``corrections`` entry (docs/contract.md), None when no frame was a repeat."""

@@ -25,7 +25,7 @@ from wallcli.signal.view_image import (
 )
 from wallcli.signal.view_light import _chroma, _objects, _relative_texture
 from wallcli.signal.view_limits import (
-    CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
+    CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, GAP_EDGE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
     MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_REGISTER_SIDE, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
     REL, REL_EDGE,
     SHARP, SIGMA_FLOOR, TEX_TAU,
@@ -387,6 +387,10 @@ class ViewCheck:
         lo = -np.inf if start is None else start
         hi = np.inf if end is None else end
         found = {k: [s for s in spans if s[1] >= lo and s[0] <= hi] for k, spans in self.spans.items()}
+        # a gap is the time strictly between the frames either side: a window cut on one side of
+        # it (no window spans one: signal.window) starts on the frame after it, or ends its nominal
+        # one grid step (1/30 s) after the frame before it, and has lost nothing
+        found["frame gap"] = [s for s in found["frame gap"] if s[1] > lo + GAP_EDGE and s[0] < hi - GAP_EDGE]
         issues = [k for k, s in found.items() if s]
         refused = [k for k in issues if k not in NOT_REFUSED]
         if self.frames == 0:

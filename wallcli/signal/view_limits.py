@@ -60,6 +60,7 @@ MIN_USABLE = 0.5  # of the frame's area, neither clipped nor dark
 SIGMA_FLOOR = 0.02  # code values: a frozen (repeated) frame has no measurable noise
 HISTORY = 64  # frames whose noise estimates are pooled (a median: a cut or a mover does not move it)
 MAX_SPANS = 64  # per kind; more are merged, so memory stays bounded
+GAP_EDGE = 0.05  # s: a window touching a frame gap by under this (one 30 fps grid step and rounding) spans none of it
 MAX_OBJECT_HITS = 600  # 'moving object' flags kept to be taken back when an overlay is found (ViewCheck.mask)
 CHECK_RATE = 3.0  # frames checked per second of a calm view: checking every frame cost more than
 # the analysis itself (3-5 ms a 1080p frame against about 3 for decoding and the plots;

@@ -47,10 +47,37 @@ NORMALIZATION_TEXT = {
 NEEDS_OFFSET = {NORMALIZATION_V3}
 
 
+# A gap in the timestamps (frames lost) up to one window long is interpolated over like any
+# resampling: the windows across it are flagged by the view check ('frame gap'), and it costs at most
+# a window's rows. A longer one would put whole windows inside lost time, answered from invented
+# samples, at a cost that grows with the gap (a 10,000 s jump: 300,000 rows): the grid restarts after it.
+MAX_BRIDGE = WINDOW / CANONICAL_FPS  # s
+
+
+def gap_starts(time: np.ndarray, bridge: float = MAX_BRIDGE) -> np.ndarray:
+    """Indices of the frames that follow a jump of the timestamps longer than ``bridge`` seconds."""
+    time = np.asarray(time, np.float64)
+    return np.flatnonzero(np.diff(time) > bridge) + 1 if time.size > 1 else np.zeros(0, np.intp)
+
+
 def resample(plot: np.ndarray, time: np.ndarray, fps: float = CANONICAL_FPS) -> tuple[np.ndarray, np.ndarray]:
-    """Resample (bins, T, C) plot with timestamps ``time`` onto a uniform ``fps`` grid from time[0]."""
+    """Resample (bins, T, C) plot with timestamps ``time`` onto a uniform ``fps`` grid from time[0].
+
+    A jump of the timestamps longer than :data:`MAX_BRIDGE` is not interpolated over: the grid
+    restarts at the first frame after it (as :class:`StreamResampler` does when told of one), so it
+    costs nothing and no sample is invented inside it; :func:`run_window_starts` keeps windows
+    from spanning it."""
     plot = np.asarray(plot, np.float32)
     time = np.asarray(time, np.float64)
+    cuts = gap_starts(time)
+    if cuts.size:
+        parts = [_resample_run(plot[:, a:b], time[a:b], fps)
+                 for a, b in zip([0, *cuts], [*cuts, time.size])]
+        return np.concatenate([p for p, _ in parts], axis=1), np.concatenate([g for _, g in parts])
+    return _resample_run(plot, time, fps)
+
+
+def _resample_run(plot: np.ndarray, time: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
     if time.size < 2:
         return plot.copy(), time.copy()
     n = int(np.floor((time[-1] - time[0]) * fps + 1e-6)) + 1
@@ -70,6 +97,15 @@ def window_starts(length: int, window: int = WINDOW, stride: int = DEFAULT_STRID
     if starts[-1] != length - window:
         starts.append(length - window)
     return starts
+
+
+def run_window_starts(grid: np.ndarray, fps: float = CANONICAL_FPS, window: int = WINDOW,
+                      stride: int = DEFAULT_STRIDE) -> list[int]:
+    """:func:`window_starts` of each run of a :func:`resample` grid that has no gap in it: no
+    window spans lost frames (each run's last window is aligned to the run's end)."""
+    grid = np.asarray(grid, np.float64)
+    cuts = np.flatnonzero(np.diff(grid) > 1.5 / fps) + 1 if grid.size > 1 else np.zeros(0, np.intp)
+    return [a + s for a, b in zip([0, *cuts], [*cuts, grid.size]) for s in window_starts(int(b - a), window, stride)]
 
 
 def normalize_window(x: np.ndarray, preprocessing: str = NORMALIZATION, offset: np.ndarray | None = None) -> np.ndarray:
@@ -174,6 +210,11 @@ class StreamResampler:
 
     def __init__(self, fps: float = CANONICAL_FPS):
         self.fps = float(fps)
+        self.restart()
+
+    def restart(self) -> None:
+        """Frames were lost before the next row (a jump of the timestamps over :data:`MAX_BRIDGE`):
+        start a new grid at it instead of interpolating over the gap."""
         self._prev = None  # (t, row)
         self._t0 = None
         self._k = 0  # index of the next grid time
@@ -196,36 +237,59 @@ class StreamResampler:
 
 
 class StreamWindower:
-    """Collect resampled rows; emit (start_time, end_time, window (bins, WINDOW, C)) every ``stride``."""
+    """Collect resampled rows; emit (start_time, end_time, window (bins, WINDOW, C)) every ``stride``.
 
-    def __init__(self, window: int = WINDOW, stride: int = DEFAULT_STRIDE):
+    Rows more than 1.5 grid steps apart (``fps``: the grid's rate) are either side of a gap (see
+    :meth:`StreamResampler.restart`): a window never spans one. The run before it ends with its
+    end-aligned window (as :func:`run_window_starts`), returned by the push that crosses the gap.
+    """
+
+    def __init__(self, window: int = WINDOW, stride: int = DEFAULT_STRIDE, fps: float = CANONICAL_FPS):
         self.window, self.stride = int(window), max(1, int(stride))
+        if self.window < 2:
+            raise ValueError("a window holds at least 2 rows")
+        self.step = 1.0 / float(fps)
         self._rows: deque = deque(maxlen=self.window)
         self._times: deque = deque(maxlen=self.window)
-        self._since = 0
+        self._since = 0  # rows since the last window emitted (or since the run began)
+        self._run = 0  # rows since the last gap
         self._count = 0
+        self.emitted = 0  # windows returned by push
 
     def push(self, t: float, row: np.ndarray):
         """Add one (bins, C) row at time ``t``; returns a window tuple when one completes, else None."""
+        done = None
+        if self._times and float(t) - self._times[-1] > 1.5 * self.step:
+            done = self.pending()  # the run before the gap: its end-aligned window
+            self._rows.clear()
+            self._times.clear()
+            self._since = self._run = 0
         self._rows.append(np.asarray(row, np.float32))
         self._times.append(float(t))
         self._count += 1
+        self._run += 1
         self._since += 1
-        if self._count >= self.window and (self._count == self.window or self._since >= self.stride):
+        if done is None and self._run >= self.window and (self._run == self.window or self._since >= self.stride):
             self._since = 0
-            return self.last()
-        return None
+            done = self.last()
+        self.emitted += done is not None
+        return done
 
     @property
     def count(self) -> int:
         return self._count
 
+    def pending(self):
+        """The current run's end-aligned window when push has not returned it, else None."""
+        return self.last() if self._since and self._run >= self.window else None
+
     def last(self):
-        """The newest full window (start, end, window), emitted or not; None before ``window`` rows.
+        """The newest full window (start, end, window), emitted or not; None before ``window`` rows
+        since the start or the last gap.
 
         The batch path's final window is aligned to the end of the clip: at the end of a stream
         it is this one (the buffer holds exactly the last ``window`` rows).
         """
-        if self._count < self.window:
+        if self._run < self.window:
             return None
         return self._times[0], self._times[-1], np.stack(self._rows, axis=1)
