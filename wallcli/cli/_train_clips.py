@@ -85,8 +85,21 @@ def write_block(out: Path, block: dict[str, Any]) -> dict[str, Any]:
     if "split" in block:
         card["split"] = block.pop("split")
     card["recordings"] = block
+    if block.get("out_of_fold"):
+        old = card.get("transfer")
+        if isinstance(old, dict) and not old.get("out_of_fold"):
+            # figures measured on clips that are now training data: kept, named for what they were
+            card["transfer_before_recordings"] = dict(old, note="measured before these clips were trained on; "
+                                                                "superseded by the out-of-fold figures")
+        card["transfer"] = transfer_block(block, card)
     if trust is not None:
-        card["confidence"] = trust
+        if isinstance(card.get("two_stage"), dict):
+            # a two-stage count's answers, which the thresholds were fitted on, are judged by the pair's
+            # block; the count net alone has no answers on the recordings to back a threshold
+            card["two_stage"]["confidence"] = trust
+            card.pop("confidence", None)
+        else:
+            card["confidence"] = trust
     write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=True)
     return read_card(out)
 
@@ -113,3 +126,22 @@ def keep_init(init: Path, out: Path, block: dict[str, Any], *, name, version, fo
             k for k in ("split", "confidence") if k in block or k == "confidence" and block.get("folds"))}
     write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=force)
     return write_block(out, block)
+
+
+def transfer_block(block: dict[str, Any], card: dict[str, Any]) -> dict[str, Any]:
+    """The card's headline figures (what ``-v`` and the report quote) from the out-of-fold table."""
+    det = block["out_of_fold"]["detectable"]
+    n = det["clips"]
+    out = {"description": (f"independent path-traced transfer set, {block['clips']} labelled recordings of other rooms, "
+                           f"out of fold ({block['folds']} folds: each clip answered by a model fitted without it); the "
+                           f"headline figures on the {n} where the people are above the camera's noise or the room is empty"),
+           "out_of_fold": True, "clips": block["clips"], "scored": n, "errors": 0,
+           "accuracy": det["accuracy"], "ci95": det["ci95"], "decided": det["decided"],
+           "coverage": round(det["decided"] / n, 4) if n else None,
+           "accuracy_decided": round(det["decided_right"] / det["decided"], 4) if det["decided"] else None,
+           "classes": card.get("classes"), "confusion": det["confusion_matrix"],
+           "by_band": block["out_of_fold"]["by_band"]}
+    old = card.get("transfer") if isinstance(card.get("transfer"), dict) else {}
+    if old.get("stages"):
+        out["stages"] = old["stages"]
+    return out

@@ -108,6 +108,7 @@ def wilson(k: int, n: int, z: float = 1.959963984540054) -> list[float] | None:
 def oof_table(recs: list[Recording], answers: dict[str, dict], task: str, classes: list) -> dict[str, Any]:
     """The card's ``recordings.out_of_fold`` block from per-clip answers {name: {label, confident}}."""
     by_band, conf = {}, np.zeros((len(classes), len(classes)), np.int64)
+    conf_det = np.zeros_like(conf)
     det_right = det_n = dec_n = dec_right = 0
     for name, lo, hi in BANDS:
         sel = [r for r in recs if band_of(r) == name]
@@ -119,6 +120,7 @@ def oof_table(recs: list[Recording], answers: dict[str, dict], task: str, classe
         a = answers[r.name]
         conf[classes.index(truth(r, task)), classes.index(a["label"])] += 1
         if r.detectable is not False:
+            conf_det[classes.index(truth(r, task)), classes.index(a["label"])] += 1
             det_n += 1
             det_right += a["label"] == truth(r, task)
             if a["confident"]:
@@ -126,7 +128,7 @@ def oof_table(recs: list[Recording], answers: dict[str, dict], task: str, classe
                 dec_right += a["label"] == truth(r, task)
     return {"detectable": {"right": int(det_right), "clips": det_n,
                            "accuracy": round(det_right / det_n, 4) if det_n else None, "ci95": wilson(det_right, det_n),
-                           "decided": dec_n, "decided_right": dec_right},
+                           "decided": dec_n, "decided_right": dec_right, "confusion_matrix": conf_det.tolist()},
             "by_band": by_band, "confusion_matrix": conf.tolist(),
             "confusion_matrix_axes": "rows: true class, columns: answer, both in the order of classes"}
 
@@ -220,7 +222,9 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
                     continue
             except (OSError, ValueError, KeyError):
                 pass  # damaged: trained again
-        if log:
+        if log and cfg.epochs == 0:
+            log(f"fold {f + 1}/{k}: the net as it is; fitting on {len(recs) - len(members)} clips, answering {len(members)}")
+        elif log:
             log(f"fold {f + 1}/{k}: training on {sum(len(r.starts) for r in recs if r not in members)} windows of "
                 f"{len(recs) - len(members)} clips, answering {len(members)} clips")
         onnx = work / f"fold-{f}.onnx"
