@@ -62,7 +62,14 @@ def test_shipped_cards_carry_the_measured_accuracy_and_the_table_says_it(task, g
     tr = card["transfer"]
     assert tr["scored"] == sum(map(sum, tr["confusion"])) and tr["ci95"][0] <= tr["accuracy"] <= tr["ci95"][1]
     assert 0 <= tr["coverage"] <= 1 and tr["decided"] == round(tr["coverage"] * tr["scored"])
-    assert card["confidence"]["calibrated_on"]["windows"] > 0
+    # the decided/undetermined thresholds are fitted on the recordings, out of fold (a two-stage
+    # count's on its pair's answers), and the card says how many clips back them
+    trust = card["two_stage"]["confidence"] if task == "count" else card["confidence"]
+    assert "out-of-fold answers on" in trust["fitted_on"] and trust["level"] >= 0.97
+    rec = card["recordings"]
+    assert rec["folds"] == 5 and rec["out_of_fold"]["detectable"]["clips"] == tr["scored"]
+    assert rec["out_of_fold"]["detectable"]["right"] == round(tr["accuracy"] * tr["scored"])
+    assert rec["candidates_compared"]["count"] >= 1
     code, out, err = run_cli(task, golden_clip, "-v")  # the card's figures, for a reader who asks
     assert code == 0, err
     said = " ".join(err.split())  # the note is wrapped to the terminal's width

@@ -101,8 +101,9 @@ def test_video_and_follow_agree(models, tmp_path, run_cli):
     code, out, err = run_cli("activity", clip, "--model", models["activity"], "--json")
     assert code == 0, err
     batch = {round(w["start"], 3): w for w in json.loads(out)["windows"]}
-    live = list(follow(Model.load(models["activity"]), str(clip), stride=64))
-    assert len(live) >= 2
+    lines = list(follow(Model.load(models["activity"]), str(clip), stride=64))
+    live, whole = lines[:-1], lines[-1]  # the windows as they complete, then the clip's answer
+    assert len(live) >= 2 and len(live) == len(batch) and "windows" in whole
     for w in live:
         ref = batch[round(w["start"], 3)]
         assert w["end"] == pytest.approx(ref["end"], abs=1e-3)
@@ -119,9 +120,12 @@ def test_follow_reads_a_stream_on_stdin(models, tmp_path):
                            stdin=stdin, capture_output=True, env=env, timeout=120)
     assert p.returncode == 0, p.stderr.decode()
     lines = p.stdout.decode().splitlines()
-    assert len(lines) == 2  # 330 samples: the first window at 256, the next 64 later
-    recs = [json.loads(x) for x in lines]
-    assert [round(r["start"] * 30) for r in recs] == [0, 64]
+    # 330 samples: the first window at 256, the next 64 later, the end-aligned one when the
+    # stream ends, then the clip's answer
+    assert len(lines) == 4
+    recs = [json.loads(x) for x in lines[:-1]]
+    assert [round(r["start"] * 30) for r in recs] == [0, 64, 74]
+    assert len(json.loads(lines[-1])["windows"]) == 3
     for r in recs:
         assert {"start", "end", "label", "probabilities"} <= set(r) and r["label"] in (0, 1, 2)
 

@@ -143,6 +143,37 @@ class _Stopped(Exception):
     that PyAV hands it back where FFmpeg returns instead of dropping it."""
 
 
+def _front_to_back(path: str) -> bool:
+    """Whether a file can be read as a stream, front to back (what reading it as it grows needs):
+    not an MP4/MOV whose index (moov) comes after its media (mdat), as most recorders write it
+    when they finish; a fragmented or 'faststart' MP4 and MPEG-TS, MKV, raw streams can."""
+    import struct
+
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(8)
+            if len(head) < 8 or head[4:8] != b"ftyp":
+                return True
+            fh.seek(0)
+            for _ in range(64):
+                box = fh.read(8)
+                if len(box) < 8:
+                    return False
+                size, kind = struct.unpack(">I4s", box)
+                if kind in (b"moov", b"moof"):
+                    return True
+                if kind == b"mdat":
+                    return False
+                if size == 1:
+                    size = struct.unpack(">Q", fh.read(8))[0] - 8
+                elif size == 0:
+                    return False
+                fh.seek(size - 8, os.SEEK_CUR)
+    except (OSError, struct.error):
+        return True
+    return False
+
+
 class StreamInput:
     """A byte stream (stdin, a FIFO) read by a thread of ours and handed to FFmpeg as a Python file.
 
@@ -269,7 +300,8 @@ class VideoReader:
         target = source
         fmt = input_format
         self._input = None
-        self.following = FOLLOW_IDLE.get() is not None and source != "-" and os.path.isfile(source)
+        self.following = (FOLLOW_IDLE.get() is not None and source != "-" and os.path.isfile(source)
+                          and _front_to_back(source))
         if source == "-" or _byte_stream(source):
             target = self._input = StreamInput(source, None if source == "-" else source, STALL.get())
         elif self.following:  # a recording still being written: read as it grows (see StreamInput)
