@@ -32,7 +32,8 @@ def test_evaluate_plot_over_labels_csv(tmp_path, run_cli, clip):
     labels.write_text("file,people,activity\nc.mkv,0,none\n")
     before = labels.read_bytes()
     code, _, err = run_cli("evaluate", tmp_path, "--task", "count", "--plot", labels, "--force")
-    assert code == 1 and "is the input" in err and labels.read_bytes() == before
+    # refused before anything is written: a figure's name must end in .png
+    assert code == 2 and ".png" in err and labels.read_bytes() == before
 
 
 def test_evaluate_plot_over_a_sidecar(tmp_path, run_cli, clip):
