@@ -53,7 +53,9 @@ def _leftovers(folder: Path, keep: set[str]) -> list[str]:
 
 def test_shadow_becomes_visible(shadow_clip, run_cli, tmp_path):
     out = tmp_path / "amp.mp4"
-    code, stdout, err = run_cli("amplify", shadow_clip, out, "--cells", "16", "--json")
+    # --smooth 0 given: this shadow crosses the frame in 2 s, faster than the smoothing the
+    # automatic choice would add (it lags the moving edge); the chosen defaults are tested below
+    code, stdout, err = run_cli("amplify", shadow_clip, out, "--cells", "16", "--smooth", "0", "--json")
     assert code == 0, err
     frames, rate = _read(out)
     assert len(frames) == N
@@ -90,7 +92,8 @@ def test_control_without_shadow_stays_uncorrelated(tmp_path, run_cli):
 
 def test_side_by_side_and_scale(shadow_clip, run_cli, tmp_path):
     out = tmp_path / "sbs.mp4"
-    code, _, err = run_cli("amplify", shadow_clip, out, "--side-by-side", "--scale", "0.5", "--cells", "16")
+    code, _, err = run_cli("amplify", shadow_clip, out, "--side-by-side", "--scale", "0.5", "--cells", "16",
+                             "--smooth", "0")
     assert code == 0, err
     frames, rate = _read(out)
     assert len(frames) == N and rate == FPS
@@ -181,3 +184,99 @@ def test_bad_input(case, shadow_clip, run_cli, tmp_path):
         assert len(_read(out)[0]) == N
     if case == "roi":
         assert f"{W}x{H}" in err
+
+
+# -- issue 46 item 11: the defaults are chosen from the clip's own signal and noise -------------
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def _strip_snr(path: Path, skip: int = 60) -> np.ndarray:
+    """Per vertical strip (4 across) of the output: the amplified signal averaged over the strip
+    and over each second, its spread over time, against the frame-to-frame noise of the strip's
+    mean (std of consecutive differences / sqrt 2). The first ``skip`` frames (the calibration
+    window, the mean still settling) are left out."""
+    frames, _ = _read(path)
+    x = np.array(frames[skip:], np.float32) - 128.0
+    out = []
+    for k in range(4):
+        w = x.shape[2] // 4
+        r = x[:, :, k * w:(k + 1) * w].mean(axis=(1, 2, 3))
+        seconds = r[: len(r) // 30 * 30].reshape(-1, 30).mean(axis=1)
+        out.append(np.std(seconds) / (np.std(np.diff(r)) / np.sqrt(2)))
+    return np.array(out)
+
+
+def test_defaults_show_the_walker_on_walking_mp4(run_cli, tmp_path):
+    """At its defaults, amplify on examples/walking.mp4 chooses coarser blocks and smoothing from
+    the measured SNR, and the person's light stands well above the output's frame-to-frame noise:
+    far more than with the old defaults (--cells 64 --smooth 0), and more than the same defaults
+    give on examples/empty.mp4 (the same room, nobody in it)."""
+    import json
+
+    new, old, empty = tmp_path / "new.mp4", tmp_path / "old.mp4", tmp_path / "empty.mp4"
+    code, stdout, err = run_cli("amplify", EXAMPLES / "walking.mp4", new, "--json")
+    assert code == 0, err
+    chosen = json.loads(stdout)
+    assert chosen["cells_mode"] == "auto" and chosen["smooth_mode"] == "auto" and chosen["gain_mode"] == "auto"
+    assert chosen["cells"] < 64 and chosen["smooth"] > 0, chosen
+    assert chosen["snr_db"] >= 12.0 and chosen["snr_db"] > chosen["tried"][0]["snr_db"] + 6, chosen
+    assert chosen["tried"][0] == {"cells": 64, "smooth": 0.0, "snr_db": chosen["tried"][0]["snr_db"]}
+    assert f"{chosen['cells']} columns" in " ".join(err.split())
+    code, _, err = run_cli("amplify", EXAMPLES / "walking.mp4", old, "--cells", "64", "--smooth", "0")
+    assert code == 0, err
+    code, _, err = run_cli("amplify", EXAMPLES / "empty.mp4", empty)
+    assert code == 0, err
+    s_new, s_old, s_empty = _strip_snr(new), _strip_snr(old), _strip_snr(empty)
+    assert len(_read(new)[0]) == 360
+    assert s_new.min() > 12 and s_new.min() > 3 * s_old.max(), (s_new, s_old)
+    assert np.median(s_new) > 2 * np.median(s_empty), (s_new, s_empty)
+
+
+def test_given_cells_and_smooth_win(run_cli, tmp_path):
+    """An explicit --cells and/or --smooth is used as given; only what is left out is chosen."""
+    import json
+
+    clip = EXAMPLES / "walking.mp4"
+    code, stdout, err = run_cli("amplify", clip, tmp_path / "a.mp4", "--cells", "64", "--smooth", "0", "--json")
+    assert code == 0, err
+    both = json.loads(stdout)
+    assert (both["cells"], both["smooth"], both["grid"]) == (64, 0.0, [48, 64])
+    assert both["cells_mode"] == both["smooth_mode"] == "given" and both["tried"] == []
+    code, stdout, err = run_cli("amplify", clip, tmp_path / "b.mp4", "--cells", "16", "--gain", "300", "--json")
+    assert code == 0, err
+    cells = json.loads(stdout)
+    assert (cells["cells"], cells["cells_mode"], cells["grid"]) == (16, "given", [12, 16])
+    assert cells["smooth_mode"] == "auto" and {t["cells"] for t in cells["tried"]} == {16}
+    assert cells["gain"] == 300 and cells["gain_mode"] == "fixed"
+    code, stdout, err = run_cli("amplify", clip, tmp_path / "c.mp4", "--smooth", "0.05", "--json")
+    assert code == 0, err
+    smooth = json.loads(stdout)
+    assert smooth["smooth"] == 0.05 and smooth["smooth_mode"] == "given" and smooth["cells_mode"] == "auto"
+    assert {t["smooth"] for t in smooth["tried"]} == {0.05}
+    # given both, the output is the one those options always gave: the same video either way
+    code, _, err = run_cli("amplify", clip, tmp_path / "d.mp4", "--cells", "16", "--smooth", "0.3", "--gain", "300")
+    assert code == 0, err
+    code, _, err = run_cli("amplify", clip, tmp_path / "e.mp4", "--smooth", "0.3", "--cells", "16", "--gain", "300",
+                           "--gain-seconds", "5")
+    assert code == 0, err
+    assert (tmp_path / "d.mp4").read_bytes() == (tmp_path / "e.mp4").read_bytes()
+
+
+def test_measured_snr_follows_the_noise_and_the_smoothing():
+    """measured_snr_db: a slow signal under white noise reads its true SNR; smoothing raises it
+    by the noise share the low-pass removes; noise alone reads far below the target."""
+    from wallcli.signal.amplify import TARGET_SNR_DB, auto_steps, choose_step, measured_snr_db
+
+    rng = np.random.default_rng(5)
+    t = np.arange(90) / 30.0
+    slow = np.sin(2 * np.pi * 0.5 * t)[:, None, None, None] * np.ones((1, 6, 8, 3))
+    noise = rng.normal(0, 0.5, slow.shape)
+    snr0 = measured_snr_db(t, slow + noise, 0.0)
+    assert snr0 == pytest.approx(10 * np.log10(0.5 / 0.25), abs=1.0)
+    assert measured_snr_db(t, slow + noise, 0.3) > snr0 + 8
+    assert measured_snr_db(t, noise, 0.0) < 0 and measured_snr_db(t, noise, 0.3) < TARGET_SNR_DB
+    steps = auto_steps(None, None)
+    assert steps[0] == (64, 0.0) and auto_steps(16, None) == [(16, s) for s in (0.0, 0.1, 0.2, 0.3, 0.5)]
+    assert auto_steps(8, 0.2) == [(8, 0.2)]
+    assert choose_step(steps, {st: (20.0 if st == (16, 0.2) else 3.0) for st in steps}) == (16, 0.2)
+    assert choose_step(steps, {st: float(i) for i, st in enumerate(steps)}) == steps[-1]

@@ -119,3 +119,27 @@ def test_decoded_frame_size_wins_over_the_announced_one():
     plot = compute_stplot(reader, bins=4)
     assert plot.meta["roi"] == [0, 0, 32, 24] and plot.meta["frame_size"] == [32, 24]
     assert np.allclose(plot.h_mean[:, 0], [101, 101, 111, 111])
+
+
+def test_the_figure_title_names_the_gain_in_words(tmp_path, run_cli, monkeypatch):
+    """Issue 46 item 11: the title said a bare 'x0.975'. That number is the colour gain (display
+    range per code value of signal); the title now names it and says how it was set."""
+    import re
+
+    import wallcli.plots.stplot as plots
+
+    titles = []
+    real = plots.save_figure
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path, **kw: titles.append(fig.axes[0].get_title(loc="left"))
+                        or real(fig, path, **kw))
+    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
+    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "auto.png")
+    assert code == 0, err
+    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "given.png", "--gain", "0.975")
+    assert code == 0, err
+    auto, given = titles
+    for title in titles:
+        assert not re.search(r"(^|\s)x\d", title), title  # no bare 'x0.975'
+        assert re.search(r"colour gain \d[\d.e+-]* display range per code value", title), title
+    assert "automatic" in auto and "robust sigma" in auto
+    assert "colour gain 0.975 display range per code value (given with --gain; full scale \u00b10.51 code values)" in given

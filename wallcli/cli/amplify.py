@@ -45,16 +45,18 @@ def amplify(
     output: Path = typer.Argument(..., help="Output video (.mp4, .mov, .m4v or .mkv; H.264).", show_default=False),
     gain: Optional[float] = number_option(None, "--gain", lo=0, hi=1e8, lo_open=True, help="Display levels per code value of signal "
                                          "(output = 128 + gain x signal). Default: automatic, +-3 robust sigma of "
-                                         "the first --gain-seconds fill the range, then fixed."),
-    gain_seconds: float = number_option(2.0, "--gain-seconds", lo=0.05, hi=600, help="Video used to measure the automatic gain "
-                                       "(those frames are written once it is known)."),
-    cells: int = number_option(64, "--cells", lo=1, hi=4096, integer=True, help="Blocks along the longer side of the ROI; each "
-                              "block is averaged exactly (noise falls as 1/sqrt(pixels)). Fewer = less noise, coarser."),
+                                         "the first --gain-seconds (after the automatic --cells and --smooth) fill the range, then fixed."),
+    gain_seconds: float = number_option(2.0, "--gain-seconds", lo=0.05, hi=600, help="Video at the start used to measure the automatic "
+                                       "gain, --cells and --smooth (those frames are held back as small grids and written once they are known)."),
+    cells: Optional[int] = number_option(None, "--cells", lo=1, hi=4096, integer=True, help="Blocks along the longer side of the ROI; each "
+                              "block is averaged exactly (noise falls as 1/sqrt(pixels)). Fewer = less noise, coarser. "
+                              "Default: automatic (64, 32, 16 or 8, with --smooth; see below)."),
     mean: str = typer.Option("ema", "--mean", help="Running temporal mean removed per block: 'ema' (exponential) "
                              "or 'window' (trailing moving average). Both start as an expanding average."),
     mean_seconds: float = number_option(10.0, "--mean-seconds", lo=0.01, hi=3600, help="Time constant of 'ema' / span of 'window'."),
-    smooth: float = number_option(0.0, "--smooth", lo=0, hi=3600, help="Temporal smoothing time constant in seconds "
-                                 "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion."),
+    smooth: Optional[float] = number_option(None, "--smooth", lo=0, hi=3600, help="Temporal smoothing time constant in seconds "
+                                 "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion. "
+                                 "Default: automatic (0 to 0.5, with --cells; see below)."),
     scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5; rounded to even sizes, at least 2x2) or "
                        "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0)."),
     side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
@@ -73,6 +75,15 @@ def amplify(
     blocks (the noise falls, the broad shadows of people stay), and the rest is shown as
     128 + gain x signal: grey where nothing changes, coloured where someone blocks or reflects
     light. One streaming pass; memory does not grow with the video's length.
+
+    Defaults chosen from the clip: on the first --gain-seconds (2 s) of video, the signal and
+    noise of the blocks are measured as `wallcli snr` does (noise from frame-to-frame
+    differences, signal = the rest), for these --cells/--smooth pairs, sharpest first: 64/0,
+    32/0, 32/0.1, 16/0.1, 16/0.2, 16/0.3, 8/0.3, 8/0.5. The first whose measured SNR reaches
+    12 dB is used, else the one with the highest SNR; then the gain maps +-3 robust sigma of
+    that signal onto the display range. A --cells, --smooth or --gain given is used as given
+    (the others are still chosen). The choice is printed with --json (cells, smooth, snr_db).
+    The video is still decoded once: those first seconds are held back as small block grids only.
 
     \b
     Examples:
@@ -111,7 +122,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import VideoWriter, atomic_path
-    from wallcli.signal.amplify import Amplifier, grid_shape, original_panel, quantisation_sigma, render_panel
+    from wallcli.signal.amplify import AutoAmplifier, grid_shape, original_panel, quantisation_sigma, render_panel
     from wallcli.signal.blocks import check_roi, rgb_grid
 
     with open_video(input, threads=threads) as reader:
@@ -124,7 +135,6 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         roi_t = check_roi(roi_t, *size)
         _, _, rw, rh = roi_t
         pw, ph = parse_scale(scale, rw, rh)
-        rows, cols = grid_shape(rw, rh, cells)
         calib = max(2, round(gain_seconds * float(info.fps)))
         if side_by_side:
             calib = max(2, min(calib, SIDE_BUFFER_BYTES // (pw * ph * 3)))
@@ -145,25 +155,40 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                         planes = frame.planes
                         if amp is None:
                             depth = planes.depth
-                            floor = quantisation_sigma(rw * rh / (rows * cols), depth)
-                            amp = Amplifier(mean=mean, mean_seconds=mean_seconds, smooth_seconds=smooth,
-                                            gain=gain, calib_frames=calib, sigma_floor=floor)
-                        grid = rgb_grid(planes, roi_t, rows, cols)
+
+                            def floor(c, depth=depth):
+                                r, k = grid_shape(rw, rh, c)
+                                return quantisation_sigma(rw * rh / (r * k), depth)
+
+                            amp = AutoAmplifier(cells=cells, smooth_seconds=smooth, mean=mean, mean_seconds=mean_seconds,
+                                                gain=gain, calib_frames=calib, sigma_floor=floor)
+                        # the grids of every block count still in question, from this one decode
+                        grids = {c: rgb_grid(planes, roi_t, *grid_shape(rw, rh, c)) for c in amp.wanted}
                         left = original_panel(planes, roi_t, pw, ph) if side_by_side else None
-                        write(amp.push(frame.time, grid, left))
+                        write(amp.push(frame.time, grids, left))
                         frames += 1
                         advance()
                 write(amp.flush() if amp is not None else [])
                 if frames < 2:
                     raise WallcliError(f"{input}: only {frames} frame(s); amplify needs at least 2")
+    rows, cols = grid_shape(rw, rh, amp.cells)
+    measured = amp.measured.get((amp.cells, amp.smooth_seconds))
     summary = {
         "input": input, "output": str(output), "frames": frames, "fps": float(info.fps),
         "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}", "width": out_w, "height": ph,
-        "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds, "smooth": smooth,
+        "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds,
+        "cells": amp.cells, "cells_mode": "auto" if amp.auto_cells else "given",
+        "smooth": amp.smooth_seconds, "smooth_mode": "auto" if amp.auto_smooth else "given",
+        # the SNR (dB) measured on the first --gain-seconds for each pair tried, and the chosen one's
+        "snr_db": None if measured is None or not np.isfinite(measured) else round(measured, 2),
+        "tried": [{"cells": c, "smooth": t, "snr_db": round(v, 2) if np.isfinite(v) else None}
+                  for (c, t), v in amp.measured.items()],
         "gain": amp.gain, "gain_mode": "auto" if amp.auto_gain else "fixed", "sigma": amp.sigma,
     }
     # the grid in the order of the JSON's "grid": [rows, cols]
     wrote((output, f"{frames} frames of {out_w}x{ph} pixels; gain {amp.gain:.4g} "
-                   f"({'automatic' if amp.auto_gain else 'given'}); the wall averaged in {rows} rows x {cols} columns of blocks"))
+                   f"({'automatic' if amp.auto_gain else 'given'}); the wall averaged in {rows} rows x {cols} columns of blocks "
+                   f"({'chosen' if amp.auto_cells else 'given'}), smoothed over {amp.smooth_seconds:g} s "
+                   f"({'chosen' if amp.auto_smooth else 'given'})"))
     if json_out:
         emit_json(summary)

@@ -53,6 +53,7 @@ def save_preview(path, truth: dict, plot, *, force: bool = False) -> None:
     a1 = fig.add_subplot(gs[0, 1])
     a2 = fig.add_subplot(gs[1, 1], sharex=a1)
     g, _ = draw_stplot([a1, a2], plot)
-    a1.set_title(f"space-time plots of the rendered video, x{g:.3g}", fontsize=9, loc="left")
+    a1.set_title(f"space-time plots of the rendered video; colour gain {g:.3g} per code value "
+                 f"(full scale \u00b1{0.5 / g:.2g} code values)", fontsize=9, loc="left")
     fig.tight_layout()
     save_figure(fig, path, force=force)

@@ -38,12 +38,19 @@ def draw_stplot(axes, plot, *, style: str = "rgb", gain: float | None = None):
     return g, image
 
 
+def stplot_title(src: str, g: float, *, automatic: bool = True) -> str:
+    """The PNG's title: the gain named in words (display range per code value of signal; the
+    range is 0-1, so full scale is +-0.5/gain code values) and how it was set."""
+    how = "automatic: \u00b13 robust sigma of the signal fill the range" if automatic else "given with --gain"
+    return (f"{src}: space-time plots, mean removed; colour gain {g:.3g} display range per code value "
+            f"({how}; full scale \u00b1{0.5 / g:.2g} code values)")
+
+
 def save_stplot_png(path, plot, *, style: str = "rgb", gain: float | None = None, force: bool = False) -> None:
     fig, axes = new_figure(2, 1, figsize=(10, 5.5), sharex=True, constrained_layout=True)
     g, image = draw_stplot(axes, plot, style=style, gain=gain)
     src = plot.meta.get("source", "")
-    axes[0].set_title(f"{src}: space-time plots, mean removed, x{g:.3g} "
-                      f"(full scale \u00b1{0.5 / g:.2g} code values)", fontsize=10, loc="left")
+    axes[0].set_title(stplot_title(src, g, automatic=gain is None), fontsize=10, loc="left")
     if image is not None:
         fig.colorbar(image, ax=list(axes), label="luminance change (code values)", shrink=0.8)
     save_figure(fig, path, force=force)

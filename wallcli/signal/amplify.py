@@ -23,6 +23,10 @@ the display range, as in the space-time plot PNGs. The gain then stays fixed for
 (a constant gain keeps brightness comparable over time: a person entering later shows up as
 stronger, instead of being normalised away). The sigma is floored at the quantisation noise of a
 block mean, so a perfectly still calibration second cannot produce an absurd gain.
+
+Block count and smoothing. Given, or chosen by :class:`AutoAmplifier` on the same calibration
+frames: the SNR of the displayed blocks is measured for each step of :data:`AUTO_LADDER` (sharpest
+first) and the first that reaches :data:`TARGET_SNR_DB` is used, else the best one.
 """
 
 from __future__ import annotations
@@ -124,7 +128,10 @@ class Amplifier:
     def signal(self, t: float, grid: np.ndarray) -> np.ndarray:
         """Mean-removed (and optionally smoothed) signal of one grid, float64 code values."""
         grid = np.asarray(grid, dtype=np.float64)
-        s = grid - self._mean.update(float(t), grid)
+        return self._smoothed(t, grid - self._mean.update(float(t), grid))
+
+    def _smoothed(self, t: float, s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=np.float64)
         if self.smooth_seconds > 0:
             if self._smooth is None:
                 self._smooth = s.copy()
@@ -152,7 +159,14 @@ class Amplifier:
         return out
 
     def push(self, t: float, grid: np.ndarray, payload: Any = None) -> list[tuple[Any, np.ndarray]]:
-        s = self.signal(t, grid)
+        return self._take(self.signal(t, grid), payload)
+
+    def push_signal(self, t: float, s: np.ndarray, payload: Any = None) -> list[tuple[Any, np.ndarray]]:
+        """:meth:`push` for a signal whose mean was already removed (by the mean this amplifier
+        was given): it is smoothed, held or displayed as a grid pushed here would be."""
+        return self._take(self._smoothed(t, s), payload)
+
+    def _take(self, s: np.ndarray, payload: Any) -> list[tuple[Any, np.ndarray]]:
         self.frames += 1
         if self.gain is not None:
             return [(payload, self._display(s))]
@@ -168,6 +182,166 @@ class Amplifier:
         if self.gain is None:
             self._calibrate()
         return self._release()
+
+
+# -- automatic --cells and --smooth -----------------------------------------------------------
+# From finest and sharpest to coarsest and slowest: each step lowers the noise of a shown block
+# further (bigger blocks average more pixels, a longer time constant more frames) and blurs more.
+AUTO_LADDER = ((64, 0.0), (32, 0.0), (32, 0.1), (16, 0.1), (16, 0.2), (16, 0.3), (8, 0.3), (8, 0.5))
+AUTO_CELLS = tuple(dict.fromkeys(c for c, _ in AUTO_LADDER))
+AUTO_SMOOTH = tuple(sorted({s for _, s in AUTO_LADDER}))
+# Signal power over noise power (per block and frame, as displayed) that a step must reach to be
+# chosen: 12 dB = a signal 4x the noise's amplitude, so the +-3 sigma display range is mostly signal.
+TARGET_SNR_DB = 12.0
+
+
+def auto_steps(cells: int | None, smooth: float | None) -> list[tuple[int, float]]:
+    """The (cells, smooth seconds) steps to choose from: the ladder, with a given value fixed."""
+    if cells is not None and smooth is not None:
+        return [(int(cells), float(smooth))]
+    if cells is not None:
+        return [(int(cells), t) for t in AUTO_SMOOTH]
+    if smooth is not None:
+        return [(c, float(smooth)) for c in AUTO_CELLS]
+    return list(AUTO_LADDER)
+
+
+def smoothing_noise_share(frame_seconds: float, smooth_seconds: float) -> float:
+    """Share of white noise's power that the one-pole low-pass keeps: b / (2 - b)."""
+    if smooth_seconds <= 0:
+        return 1.0
+    b = 1.0 - math.exp(-max(frame_seconds, 1e-9) / smooth_seconds)
+    return b / (2.0 - b)
+
+
+def measured_snr_db(times: np.ndarray, signals: np.ndarray, smooth_seconds: float) -> float:
+    """Signal-to-noise of the displayed blocks (dB) if ``signals`` were smoothed with
+    ``smooth_seconds``, as the SNR estimator measures it (wallcli.signal.snr): the noise power is
+    half the mean square frame-to-frame difference of the unsmoothed, mean-removed block signals,
+    scaled by the share the low-pass keeps; the signal power is the smoothed signals' mean square
+    less that noise. ``signals``: (frames, rows, cols, 3), the first frame (signal 0) left out."""
+    x = np.asarray(signals, np.float32)
+    if len(x) < 3:
+        return -math.inf
+    d = np.diff(x, axis=0)
+    noise = 0.5 * float(np.mean(d * d, dtype=np.float64))
+    if smooth_seconds > 0:
+        y = np.empty_like(x)
+        y[0] = x[0]
+        for i in range(1, len(x)):
+            b = 1.0 - math.exp(-max(float(times[i] - times[i - 1]), 0.0) / smooth_seconds)
+            y[i] = y[i - 1] + np.float32(b) * (x[i] - y[i - 1])
+        x = y
+        noise *= smoothing_noise_share(float(np.median(np.diff(times))), smooth_seconds)
+    total = float(np.mean(x * x, dtype=np.float64))
+    if noise <= 0:
+        return math.inf if total > 0 else -math.inf
+    return 10.0 * math.log10(max(total - noise, 1e-30) / noise)
+
+
+def choose_step(steps, measured: dict) -> tuple[int, float]:
+    """The first step whose measured SNR reaches :data:`TARGET_SNR_DB`, else the best one."""
+    for step in steps:
+        if measured[step] >= TARGET_SNR_DB:
+            return step
+    return max(steps, key=lambda st: measured[st])
+
+
+class AutoAmplifier:
+    """An :class:`Amplifier` whose block count (``cells``) and smoothing, where not given (None),
+    are chosen from the clip's own signal and noise.
+
+    The first ``calib_frames`` frames (the automatic gain's calibration, bounded by the caller)
+    are held back as small grids at every block count still in question (:attr:`wanted`: the
+    caller computes those grids from the same decoded frame, so nothing is decoded twice); each
+    step of :func:`auto_steps` gets its SNR measured (:func:`measured_snr_db`), one is chosen
+    (:func:`choose_step`), and the held frames go through the chosen amplifier, which goes on
+    from there (same running mean, gain measured on the same frames). Memory: a few small grids
+    per held frame, whatever the video's length or size.
+    """
+
+    def __init__(self, *, cells: int | None = None, smooth_seconds: float | None = None, mean: str = "ema",
+                 mean_seconds: float = 10.0, gain: float | None = None, calib_frames: int = 60, sigma_floor=None):
+        self.steps = auto_steps(cells, smooth_seconds)
+        self.auto_cells, self.auto_smooth = cells is None, smooth_seconds is None
+        self._kw = dict(mean=mean, mean_seconds=mean_seconds, gain=gain)
+        self.calib_frames = max(3, int(calib_frames))
+        self._floor = sigma_floor or (lambda c: 0.0)  # cells -> the gain's sigma floor
+        self.measured: dict[tuple[int, float], float] = {}
+        self.cells: int | None = None
+        self.smooth_seconds: float | None = None
+        self.amp: Amplifier | None = None
+        self._means = {c: Amplifier(mean=mean, mean_seconds=mean_seconds, gain=1.0)._mean for c in self.wanted}
+        self._held: deque = deque()
+        if len(self.steps) == 1:
+            self._start(self.steps[0])
+
+    @property
+    def wanted(self) -> tuple[int, ...]:
+        """The block counts whose grids the next :meth:`push` needs."""
+        if self.cells is not None:
+            return (self.cells,)
+        return tuple(dict.fromkeys(c for c, _ in self.steps))
+
+    @property
+    def chosen(self) -> bool:
+        return self.amp is not None
+
+    def _start(self, step: tuple[int, float]) -> None:
+        self.cells, self.smooth_seconds = step
+        self.amp = Amplifier(smooth_seconds=self.smooth_seconds, calib_frames=self.calib_frames,
+                             sigma_floor=self._floor(self.cells), **self._kw)
+
+    def push(self, t: float, grids: dict, payload: Any = None) -> list[tuple[Any, np.ndarray]]:
+        if self.amp is not None:
+            return self.amp.push(t, grids[self.cells], payload)
+        signals = {}
+        for c in self.wanted:
+            g = np.asarray(grids[c], np.float64)
+            signals[c] = (g - self._means[c].update(float(t), g)).astype(np.float32)
+        self._held.append((float(t), payload, signals))
+        if len(self._held) < self.calib_frames:
+            return []
+        return self._choose()
+
+    def _choose(self) -> list[tuple[Any, np.ndarray]]:
+        times = np.array([t for t, _, _ in self._held], np.float64)
+        for step in self.steps:
+            c, tau = step
+            # frame 0's signal is exactly 0 (the mean is that frame): left out
+            self.measured[step] = measured_snr_db(times[1:], np.stack([s[c] for _, _, s in self._held][1:]), tau)
+        self._start(choose_step(self.steps, self.measured))
+        self.amp._mean = self._means[self.cells]
+        out = []
+        # the chosen amplifier holds them again until its gain is known (calib_frames of them,
+        # or all of a shorter clip, at flush), then releases them in order
+        while self._held:
+            t, payload, signals = self._held.popleft()
+            out += self.amp.push_signal(t, signals[self.cells], payload)
+        self._means = {self.cells: self._means[self.cells]}
+        return out
+
+    def flush(self) -> list[tuple[Any, np.ndarray]]:
+        if self.amp is None:
+            if not self._held:
+                return []
+            out = self._choose()
+        else:
+            out = []
+        return out + self.amp.flush()
+
+    # what the summary reports, as the plain Amplifier has them
+    @property
+    def gain(self):
+        return None if self.amp is None else self.amp.gain
+
+    @property
+    def sigma(self):
+        return None if self.amp is None else self.amp.sigma
+
+    @property
+    def auto_gain(self) -> bool:
+        return self._kw["gain"] is None
 
 
 # -- display: from grids and planes to uint8 RGB panels -----------------------------------------
