@@ -280,3 +280,22 @@ def test_measured_snr_follows_the_noise_and_the_smoothing():
     assert auto_steps(8, 0.2) == [(8, 0.2)]
     assert choose_step(steps, {st: (20.0 if st == (16, 0.2) else 3.0) for st in steps}) == (16, 0.2)
     assert choose_step(steps, {st: float(i) for i, st in enumerate(steps)}) == steps[-1]
+
+
+def test_automatic_gain_keeps_pure_noise_near_grey():
+    """On blocks of noise alone (an empty room), full scale is at least NOISE_FULL_SCALE noise
+    sigmas: the noise is shown as speckle of at most +-127/NOISE_FULL_SCALE levels, not stretched
+    into bright blobs that would look like people."""
+    import numpy as np
+
+    from wallcli.signal.amplify import NOISE_FULL_SCALE, AutoAmplifier
+
+    rng = np.random.default_rng(3)
+    amp = AutoAmplifier(calib_frames=60)
+    shown = []
+    for i in range(120):
+        grids = {c: (100.0 + rng.normal(0, 1.0, (max(c * 3 // 4, 1), c, 3))).astype(np.float32) for c in amp.wanted}
+        shown += [d for _, d in amp.push(i / 30, grids)]
+    shown += [d for _, d in amp.flush()]
+    late = np.stack(shown[60:]) - 128.0
+    assert amp.gain is not None and late.std() <= 127.0 / 10 * 1.3

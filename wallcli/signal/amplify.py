@@ -239,6 +239,24 @@ def measured_snr_db(times: np.ndarray, signals: np.ndarray, smooth_seconds: floa
     return 10.0 * math.log10(max(total - noise, 1e-30) / noise)
 
 
+# The automatic gain never puts full scale under this many noise sigmas: on a clip with nothing but
+# noise (an empty room) the display stays near grey, speckled at +-127/NOISE_FULL_SCALE levels,
+# instead of stretching the noise into bright blobs that look like people.
+NOISE_FULL_SCALE = 10.0
+
+
+def noise_sigma(times: np.ndarray, signals: np.ndarray, smooth_seconds: float) -> float:
+    """The displayed blocks' noise sigma after smoothing: as :func:`measured_snr_db` measures it."""
+    x = np.asarray(signals, np.float32)
+    if len(x) < 3:
+        return 0.0
+    d = np.diff(x, axis=0)
+    noise = 0.5 * float(np.mean(d * d, dtype=np.float64))
+    if smooth_seconds > 0:
+        noise *= smoothing_noise_share(float(np.median(np.diff(times))), smooth_seconds)
+    return math.sqrt(max(noise, 0.0))
+
+
 def choose_step(steps, measured: dict) -> tuple[int, float]:
     """The first step whose measured SNR reaches :data:`TARGET_SNR_DB`, else the best one."""
     for step in steps:
@@ -312,6 +330,8 @@ class AutoAmplifier:
             self.measured[step] = measured_snr_db(times[1:], np.stack([s[c] for _, _, s in self._held][1:]), tau)
         self._start(choose_step(self.steps, self.measured))
         self.amp._mean = self._means[self.cells]
+        noise = noise_sigma(times[1:], np.stack([s[self.cells] for _, _, s in self._held][1:]), self.smooth_seconds)
+        self.amp.sigma_floor = max(self.amp.sigma_floor, NOISE_FULL_SCALE / SIGMAS_TO_FULL_SCALE * noise)
         out = []
         # the chosen amplifier holds them again until its gain is known (calib_frames of them,
         # or all of a shorter clip, at flush), then releases them in order
