@@ -19,6 +19,8 @@ for task, src in (("count", "runs/cand/count-keep.json"), ("activity", "runs/can
         "count": CANDIDATES[task], "where": "research/recordings/README.md",
         "rule": "shipped only when paired against the previous model on the same clips: exact McNemar p <= 0.1, "
                 "no band down by 2 or more"}
+    if task == "activity":  # what the split does on the simulator's windows (sim_split.py)
+        card["validation_with_split"] = json.loads((ROOT / "runs" / "sim_split.json").read_text())
     if task == "count":
         act = json.loads((ROOT / "runs/cand/activity-split.json").read_text())
         card["two_stage"]["activity_model"].update(name=act["name"], version=act["version"])

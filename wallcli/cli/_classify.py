@@ -195,6 +195,11 @@ def _simulated_note(card: dict) -> str | None:
     others = [o.get("visible") or {} for o in v.get("other_sets") or [] if isinstance(o, dict)]
     others = [o for o in others if isinstance(o.get("accuracy"), (int, float))]
     more = "".join(f"; {o['accuracy']:.0%}{ci(o)} of visible windows on another set" for o in others)
+    split = card.get("validation_with_split") if isinstance(card.get("validation_with_split"), dict) else {}
+    sv = split.get("visible") if isinstance(split.get("visible"), dict) else {}
+    if isinstance(sv.get("with_split"), (int, float)):  # the shipped answers are the net's with the split
+        more += (f"; with the waving/jumping split, {sv['with_split']:.0%} of visible windows on a fresh set "
+                 f"(the net alone: {sv.get('net_alone', float('nan')):.0%})")
     return (f"right on {vis['accuracy']:.0%}{ci(vis)} of "
             f"simulated windows where the people are visible (their signal >= {vis.get('min_snr_db', -10):g} dB), {v['accuracy']:.0%}"
             f"{ci(v)} of all{more}; a faint or distant mover reads as nobody. See the model card.")

@@ -31,9 +31,10 @@ def prepare(cfg, task: str, clips: list[Path], sim_data: list[Path], folds: int,
     block: dict[str, Any] = {"clips": len(recs), "windows": windows, "stride": HARVEST_STRIDE,
                              "folders": [str(c) for c in clips], "folds": folds}
     log(f"{len(recs)} labelled clips, {windows} windows (every {HARVEST_STRIDE} samples at 30 fps)")
+    split_sim = fl.simulated_split_data(sim_data, split) if split and sim_data else None
     if folds:
         answers = fl.cross_validate(cfg, fold_dirs, sim_data, recs, work, bars=bars, log=log,
-                                    load=lambda p: load_classifier(task, p), split=split)
+                                    load=lambda p: load_classifier(task, p), split=split, split_sim=split_sim)
         classes = [0, 1, 2] if task == "count" else ["none", "walking", "crouching", "waving", "jumping"]
         table, trust = judge_out_of_fold(recs, answers, task, classes, level, folds)
         block.update(fold_rule=FOLD_RULE, out_of_fold=table, confidence=trust)
@@ -43,7 +44,7 @@ def prepare(cfg, task: str, clips: list[Path], sim_data: list[Path], folds: int,
     if split:
         from wallcli.train.folds import fit_split
 
-        block["split"] = fit_split(recs, split)
+        block["split"] = fit_split(recs, split, split_sim)
     final = replace(cfg, data=list(fold_dirs) + list(sim_data),
                     val_fraction=0.0 if cfg.val is None else cfg.val_fraction)
     return final, block

@@ -33,7 +33,9 @@ def train(
     split: Optional[str] = typer.Option(None, "--split", help="activity with --clips: two answers the net confuses "
                                         "(e.g. 'waving,jumping'); where the net's answer is one of them, their probability "
                                         "is shared again by a logistic regression on the plots' physical features, fitted "
-                                        "on the recordings (wallcli/infer/split.py), out of fold with --folds."),
+                                        "on the recordings (wallcli/infer/split.py), out of fold with --folds; with "
+                                        "--data (activity datasets), on the simulator's scenes of the pair too, each set "
+                                        "weighted to count as much as the other."),
     clip_cache: Optional[Path] = typer.Option(None, "--clip-cache", help="Where the recordings' windows are cached "
                                               "(default: $WALLCLI_CACHE/recordings or ~/.cache/wallcli/recordings)."),
     out: Path = typer.Option(..., "--out", "-o", help="Model to write (.onnx); its card goes beside it (.json)."),

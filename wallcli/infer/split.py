@@ -72,12 +72,16 @@ def from_card(card: dict[str, Any]) -> Split | None:
     return None if block is None else Split(block, list(card["classes"]))
 
 
-def fit(X: np.ndarray, y: np.ndarray, *, l2: float = 1.0, iters: int = 50) -> dict[str, Any]:
+def fit(X: np.ndarray, y: np.ndarray, *, l2: float = 1.0, iters: int = 50,
+        weights: np.ndarray | None = None) -> dict[str, Any]:
     """Logistic regression (Newton's method, an L2 penalty on the standardised coefficients):
-    deterministic, no optimiser to tune. ``y``: 1 for the pair's second answer."""
+    deterministic, no optimiser to tune. ``y``: 1 for the pair's second answer; ``weights``: each
+    row's weight (default 1)."""
     X = np.asarray(X, np.float64)
     y = np.asarray(y, np.float64)
-    mean, scale = X.mean(0), X.std(0)
+    sw = np.ones(len(y)) if weights is None else np.asarray(weights, np.float64)
+    mean = (X * sw[:, None]).sum(0) / sw.sum()
+    scale = np.sqrt(((X - mean) ** 2 * sw[:, None]).sum(0) / sw.sum())
     scale = np.where(scale > 1e-12, scale, 1.0)
     Z = np.concatenate([(X - mean) / scale, np.ones((len(X), 1))], 1)
     w = np.zeros(Z.shape[1])
@@ -85,8 +89,8 @@ def fit(X: np.ndarray, y: np.ndarray, *, l2: float = 1.0, iters: int = 50) -> di
     pen[-1] = 0.0
     for _ in range(iters):
         p = 1.0 / (1.0 + np.exp(-np.clip(Z @ w, -50, 50)))
-        g = Z.T @ (p - y) + pen * w
-        H = (Z * (p * (1 - p))[:, None]).T @ Z + np.diag(pen) + 1e-9 * np.eye(len(w))
+        g = Z.T @ (sw * (p - y)) + pen * w
+        H = (Z * (sw * p * (1 - p))[:, None]).T @ Z + np.diag(pen) + 1e-9 * np.eye(len(w))
         step = np.linalg.solve(H, g)
         w -= step
         if np.abs(step).max() < 1e-10:

@@ -195,7 +195,7 @@ def _identity(cfg, f: int, k: int, recs: list[Recording], extra: dict) -> str:
 
 def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[Recording], work: Path, *,
                    load, bars, log=None, extra: dict | None = None,
-                   split: list | None = None) -> dict[str, dict[str, Any]]:
+                   split: list | None = None, split_sim=None) -> dict[str, dict[str, Any]]:
     """Out-of-fold answers {clip: {"probs", "signal_db", "fold"}}: for each fold, the net trained by
     ``cfg`` on the other folds (and ``sim_data``), exported, loaded with ``load(path)`` as the
     commands load it, answers the fold's clips. Each fold's answers are kept in ``work``: a rerun
@@ -210,7 +210,8 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
     answers: dict[str, dict[str, Any]] = {}
     for f in range(k):
         members = [r for r in recs if fold_of(r.name, k) == f]
-        ident = _identity(cfg, f, k, recs, dict(extra or {}, split=split))
+        ident = _identity(cfg, f, k, recs, dict(extra or {}, split=split, split_sim=None if split_sim is None else
+                                                            [len(split_sim[1]), float(np.sum(split_sim[0]))]))
         done = work / f"fold-{f}.answers.json"
         if done.is_file():
             try:
@@ -230,7 +231,7 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
         onnx = work / f"fold-{f}.onnx"
         if cfg.epochs == 0:  # the net as it is: only the split (and the thresholds) come from the recordings
             model = load(Path(cfg.init))
-            _attach_split(model, [r for r in recs if r not in members], split)
+            _attach_split(model, [r for r in recs if r not in members], split, split_sim)
             got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
                             "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
             write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
@@ -245,7 +246,7 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
                       "preprocessing": cfg.preprocessing, "stride": 64, "training_data": {"folds": [str(d) for d in fcfg.data]},
                       "training": {"fold": f, "of": k}, "validation": None}, force=True, seed=cfg.seed)
         model = load(onnx)
-        _attach_split(model, [r for r in recs if r not in members], split)
+        _attach_split(model, [r for r in recs if r not in members], split, split_sim)
         got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
                         "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
         write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
@@ -269,19 +270,56 @@ def _split_data(recs: list[Recording], pair: list) -> tuple[np.ndarray, np.ndarr
     return np.array(X), np.array([1.0 if r.activity == pair[1] else 0.0 for r in use])
 
 
-def fit_split(recs: list[Recording], pair: list) -> dict[str, Any]:
+def simulated_split_data(data: list[Path], pair: list) -> tuple[np.ndarray, np.ndarray]:
+    """The simulator's scenes of the pair in activity datasets ``data``: each scene's windows' mean
+    features (a scene is a clip: its windows cut from one rendered room), 1 for the pair's second."""
+    from wallcli.datagen.dataset import CLASSES
+    from wallcli.io.arrays import load_npz
+    from wallcli.signal.features import window_features
+
+    want = [CLASSES["activity"].index(c) for c in pair]
+    rows: dict[tuple, list] = {}
+    for d in data:
+        for f in sorted(Path(d).glob("shard-*.npz")):
+            a, meta = load_npz(f)
+            lab = np.asarray(a["activity"] if "activity" in a else a["label"])
+            keep = np.flatnonzero(np.isin(lab, want) & (np.asarray(a.get("people", np.ones_like(lab))) <= 1))
+            if not len(keep):
+                continue
+            feats = window_features(a["horizontal"][keep], a["vertical"][keep], a["h_offset"][keep], a["v_offset"][keep])
+            scenes = meta.get("scenes") or [{} for _ in lab]
+            for i, row in zip(keep, feats):
+                key = (str(d), scenes[i].get("seed"), scenes[i].get("index", f"{f.name}:{i}"))
+                rows.setdefault(key, [int(lab[i] == want[1]), []])[1].append(row)
+    if not rows:
+        raise WallcliError(f"--split: no simulated windows of {pair[0]} or {pair[1]} in {', '.join(map(str, data))}")
+    X = np.array([np.mean(v[1], axis=0) for v in rows.values()])
+    return X, np.array([float(v[0]) for v in rows.values()])
+
+
+def fit_split(recs: list[Recording], pair: list, sim: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
+    """The split fitted on the recordings' clips of the pair; with ``sim`` (simulated scenes), on
+    both, each set weighted to count as much as the other in all."""
     from wallcli.infer.split import fit
 
     X, y = _split_data(recs, pair)
-    block = fit(X, y)
-    block.update(pair=list(pair), fitted_on=f"{len(y)} labelled recordings of {pair[0]} or {pair[1]} (detectable, one person)")
+    what = f"{len(y)} labelled recordings of {pair[0]} or {pair[1]} (detectable, one person)"
+    w = np.ones(len(y))
+    if sim is not None:
+        Xs, ys = sim
+        w = np.concatenate([w, np.full(len(ys), len(y) / len(ys))])
+        X, y = np.concatenate([X, Xs]), np.concatenate([y, ys])
+        what += (f" and {len(ys)} simulated scenes of the pair, each set weighted to count as much as the other "
+                 f"(a simulated scene weighs {w[-1]:.3f} of a recording)")
+    block = fit(X, y, weights=w)
+    block.update(pair=list(pair), fitted_on=what)
     return block
 
 
-def _attach_split(model, train_recs: list[Recording], pair: list | None) -> None:
-    """The fold's model with a split fitted on the other folds' clips only."""
+def _attach_split(model, train_recs: list[Recording], pair: list | None, sim=None) -> None:
+    """The fold's model with a split fitted on the other folds' clips only (and ``sim``)."""
     if not pair:
         return
     from wallcli.infer.split import Split
 
-    model.split = Split(fit_split(train_recs, pair), list(model.classes))
+    model.split = Split(fit_split(train_recs, pair, sim), list(model.classes))
