@@ -348,7 +348,9 @@ def test_a_timestamp_jump_costs_nothing_and_no_window_sits_in_it(jumpy, tmp_path
         assert _cli(["stplot", jumpy, "-o", source]).returncode == 0
     p = _cli(["count", source, "--follow" if how == "follow" else "--json"])
     assert p.returncode == 0, p.stderr
-    windows = [json.loads(s) for s in p.stdout.splitlines()] if how == "follow" else json.loads(p.stdout)["windows"]
+    # --follow: a line per window, then the clip's answer (the --json object, with its windows)
+    windows = ([w for w in map(json.loads, p.stdout.splitlines()) if "windows" not in w] if how == "follow"
+               else json.loads(p.stdout)["windows"])
     before = [w for w in windows if w["end"] <= 10.0 + 1e-3]
     after = [w for w in windows if w["start"] >= JUMP + 10.0 - 1e-3]
     assert before and after and len(before) + len(after) == len(windows) <= 4, [(w["start"], w["end"]) for w in windows]
@@ -508,11 +510,14 @@ def test_follow_reads_a_file_as_a_recorder_writes_it(tmp_path):
         stop.set()
         t.join(10)
     assert p.returncode == 0 and "truncated" not in p.stderr, p.stderr
-    windows = [json.loads(s) for s in p.stdout.splitlines()]
-    assert len(windows) == 6 and windows[-1]["start"] == pytest.approx(10.667, abs=0.01)  # 20 s: every stride
+    lines = [json.loads(s) for s in p.stdout.splitlines()]
+    windows, whole = lines[:-1], lines[-1]  # a line per window, then the clip's answer
+    assert [w["start"] for w in whole["windows"]] == [w["start"] for w in windows]
+    # 20 s: every stride (the 6th at 10.667 s), then the window aligned to the end
+    assert len(windows) == 7 and windows[5]["start"] == pytest.approx(10.667, abs=0.01)
     assert time.monotonic() - start >= 6 + 5 - 1  # it waited for the recorder, then for --idle-timeout
     code = _cli(["count", tmp_path / "whole.ts", "--follow", "--idle-timeout", "0"], timeout=120)
-    assert [json.loads(s)["start"] for s in code.stdout.splitlines()] == [w["start"] for w in windows]
+    assert [json.loads(s)["start"] for s in code.stdout.splitlines()[:-1]] == [w["start"] for w in windows]
 
 
 def test_idle_timeout_is_said_in_help(run_cli):

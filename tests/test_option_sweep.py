@@ -166,13 +166,15 @@ def _check(argv, code, out, err, work, inputs_before, inputs_dir):
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("inputs")
-    clip = write_clip(folder / "c.mkv", lambda i: np.full((24, 32, 3), 120.0)
-                      + np.random.default_rng(i).normal(0, 1.0, (24, 32, 3)), 12, fps=30, codec="ffv1",
+    # 48x40: the smallest frames the camera-motion check can judge are 33 samples a side (a smaller
+    # one is 'too small to check', which --strict rightly refuses)
+    clip = write_clip(folder / "c.mkv", lambda i: np.full((40, 48, 3), 120.0)
+                      + np.random.default_rng(i).normal(0, 1.0, (40, 48, 3)), 12, fps=30, codec="ffv1",
                       pix_fmt="bgr0", options={})
     plot = write_plot(folder / "p.npz")
     labelled = folder / "labelled"  # a folder of clips with labels (wallcli evaluate)
     labelled.mkdir()
-    write_clip(labelled / "long.mkv", lambda i: np.full((24, 32, 3), 120.0), 270, fps=30, codec="ffv1",
+    write_clip(labelled / "long.mkv", lambda i: np.full((40, 48, 3), 120.0), 270, fps=30, codec="ffv1",
                pix_fmt="bgr0", options={})
     (labelled / "labels.csv").write_text("file,people,activity\nlong.mkv,0,none\n")
     return folder, {"clip": str(clip), "plot": str(plot), "input": str(clip), "labelled": str(labelled)}

@@ -36,12 +36,20 @@ def test_one_liners_print_an_answer_only_when_it_is_decided():
 
 
 def test_the_decided_figures_in_the_text_are_the_tables():
-    """'activity's decided answers X right of Y' beside a table whose detectable row says 'Y (X)'."""
-    said = re.search(r"activity's decided answers (\d+) right of (\d+)", " ".join(README.split()))
-    assert said, "the README states activity's decided answers"
+    """The models table's decided columns are the cards' out-of-fold figures, and the text says
+    what they mean: 'decides nothing' when both are 0."""
+    import json
+
     row = next(line for line in README.splitlines() if line.startswith("| **detectable** |"))
-    decided = row.strip("|").split("|")[-1].strip()
-    assert decided == f"{said.group(2)} ({said.group(1)})"
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    decided = {"count": cells[2], "activity": cells[4]}
+    for task, shown in decided.items():
+        card = json.loads((ROOT / "models" / f"{task}.json").read_text())
+        det = card["recordings"]["out_of_fold"]["detectable"]
+        want = "0" if det["decided"] == 0 else f"{det['decided']} ({det['decided_right']})"
+        assert shown == want, task
+    if set(decided.values()) == {"0"}:
+        assert "decides nothing" in " ".join(README.split())
 
 
 def test_links_lead_somewhere():

@@ -30,7 +30,7 @@ def save_npz(path: str | os.PathLike, arrays: dict[str, np.ndarray], meta: dict,
                     _write_npy(fid, v)
 
 
-def _write_npy(fid, a: np.ndarray, step_bytes: int = 1 << 20) -> None:
+def _write_npy(fid, a: np.ndarray, step_bytes: int = 1 << 16) -> None:
     """One .npy member, its data in C order a slab of about ``step_bytes`` at a time: np.savez
     copies a whole array (chunk.tobytes) to write it, a second plot's worth of memory."""
     from numpy.lib import format as npy
