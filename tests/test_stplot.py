@@ -59,16 +59,22 @@ def test_stplot_warns_when_the_roi_is_narrower_than_its_bins(tmp_path, run_cli):
     assert code == 0 and "bins" not in err and json.loads(stdout)["warnings"] == []
 
 
-def test_the_figure_title_writes_full_scale_as_plus_minus(tmp_path, run_cli, monkeypatch):
-    """'full scale = +-0.513' read as code; the title says '\u00b10.51' (two digits)."""
-    import re
-
+def _capture_titles(monkeypatch) -> list:
+    """The left titles of every figure stplot saves, in order (the figure is still written)."""
     import wallcli.plots.stplot as plots
 
     titles = []
     real = plots.save_figure
     monkeypatch.setattr(plots, "save_figure", lambda fig, path, **kw: titles.append(fig.axes[0].get_title(loc="left"))
                         or real(fig, path, **kw))
+    return titles
+
+
+def test_the_figure_title_writes_full_scale_as_plus_minus(tmp_path, run_cli, monkeypatch):
+    """'full scale = +-0.513' read as code; the title says '\u00b10.51' (two digits)."""
+    import re
+
+    titles = _capture_titles(monkeypatch)
     clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
     code, _, err = run_cli("stplot", clip, "--png", tmp_path / "p.png")
     assert code == 0, err
@@ -126,12 +132,7 @@ def test_the_figure_title_names_the_gain_in_words(tmp_path, run_cli, monkeypatch
     range per code value of signal); the title now names it and says how it was set."""
     import re
 
-    import wallcli.plots.stplot as plots
-
-    titles = []
-    real = plots.save_figure
-    monkeypatch.setattr(plots, "save_figure", lambda fig, path, **kw: titles.append(fig.axes[0].get_title(loc="left"))
-                        or real(fig, path, **kw))
+    titles = _capture_titles(monkeypatch)
     clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
     code, _, err = run_cli("stplot", clip, "--png", tmp_path / "auto.png")
     assert code == 0, err

@@ -3,7 +3,6 @@ import sys, json
 import numpy as np
 sys.path.insert(0, __import__('os').path.dirname(__file__))
 from common import *
-from oof_head import fit
 import wavejump as wj
 
 recs, X, folds = wj.recs, wj.X, wj.folds
@@ -11,13 +10,7 @@ base = json.load(open(ROOT / "runs" / "baseline_probs.json"))
 sel = np.array([r.people in (1, 2) and bool(r.detectable) for r in recs])
 y = np.array([1 if r.people == 2 else 0 for r in recs])
 for name, cols in (("feat14", slice(5, 19)), ("all", slice(0, 19))):
-    q = np.zeros(len(recs))
-    for f in range(K):
-        tr = sel & (folds != f)
-        mu, sd = X[tr][:, cols].mean(0), X[tr][:, cols].std(0) + 1e-9
-        m = fit((X[tr][:, cols] - mu) / sd, y[tr], 2, 1e-2, balance=True)
-        te = folds == f
-        q[te] = m((X[te][:, cols] - mu) / sd)[:, 1]
+    q = wj.oof_second(X[:, cols], y, sel, folds, balance=True)
     for mode in ("replace", "product"):
         newr, oldr = [], []
         for j, r in enumerate(recs):

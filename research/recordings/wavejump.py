@@ -1,7 +1,7 @@
 """Waving against jumping: what in the plots tells them apart on the recordings (out of fold)."""
 import sys, json
 import numpy as np
-import torch
+
 sys.path.insert(0, __import__('os').path.dirname(__file__))
 from common import *
 from oof_head import fit
@@ -30,6 +30,18 @@ def extra(r):
         out.append(np.stack([top, hv, fr, pk, ext], 1).mean(0))
     return out[0]
 
+def oof_second(X, y, sel, folds, balance=False):
+    """P(second of the pair) for every clip, each fold's from a logistic fitted on the other folds' ``sel`` rows."""
+    q = np.zeros(len(X))
+    for f in range(K):
+        tr = sel & (folds != f)
+        mu, sd = X[tr].mean(0), X[tr].std(0) + 1e-9
+        m = fit((X[tr] - mu) / sd, y[tr], 2, 1e-2, balance=balance)
+        te = folds == f
+        q[te] = m((X[te] - mu) / sd)[:, 1]
+    return q
+
+
 X = np.array([np.concatenate([extra(r), E["feat"][E["clip"] == j].mean(0)]) for j, r in enumerate(recs)])
 sel = np.array([r.activity in ("waving", "jumping") and r.detectable and r.persons <= 1 for r in recs])
 y = np.array([1 if r.activity == "jumping" else 0 for r in recs])
@@ -50,13 +62,7 @@ base = json.load(open(ROOT / "runs" / "baseline_probs.json"))
 act = [r for r in recs]
 for name, cols in (("feat14", slice(5, 19)), ("all", slice(0, 19))):
     newright, oldright = [], []
-    q = np.zeros(len(recs))
-    for f in range(K):
-        tr = sel & (folds != f)
-        mu, sd = X[tr][:, cols].mean(0), X[tr][:, cols].std(0) + 1e-9
-        m = fit((X[tr][:, cols] - mu) / sd, y[tr], 2, 1e-2, balance=False)
-        te = folds == f
-        q[te] = m((X[te][:, cols] - mu) / sd)[:, 1]
+    q = oof_second(X[:, cols], y, sel, folds)
     for j, r in enumerate(recs):
         if not scored(r, "activity"):
             continue

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -11,8 +10,9 @@ import numpy as np
 
 
 def default_cache() -> Path:
-    base = os.environ.get("WALLCLI_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "wallcli")
-    return Path(base) / "recordings"
+    from wallcli.datagen.ptcache import cache_base
+
+    return cache_base() / "recordings"
 
 
 def prepare(cfg, task: str, clips: list[Path], sim_data: list[Path], folds: int, cache: Path | None, out: Path,
@@ -109,22 +109,18 @@ def keep_init(init: Path, out: Path, block: dict[str, Any], *, name, version, fo
     """``--epochs 0``: OUT is --init's graph, byte for byte, with a card that says so and carries
     what was fitted on the recordings."""
     from wallcli.infer.card import card_path, read_card
-    from wallcli.infer.card import sha256_file
     from wallcli.io.writer import atomic_path, write_text_atomic
 
     card = read_card(init)
+    base = {"name": card.get("name"), "version": card.get("version"), "sha256": card["sha256"]}
     with atomic_path(out, force=force) as tmp:
         tmp.write_bytes(Path(init).read_bytes())
-    card["sha256"] = sha256_file(out)
-    card["onnx"] = dict(card.get("onnx") or {}, file=out.name) if isinstance(card.get("onnx"), dict) else card.get("onnx")
-    if name:
-        card["name"] = name
-    card["version"] = version
+    if isinstance(card.get("onnx"), dict):
+        card["onnx"]["file"] = out.name
+    card["name"], card["version"] = name or card.get("name"), version
+    fitted = [k for k in ("split",) if k in block] + (["confidence"] if block.get("folds") else [])
     card.setdefault("training", {})["recordings_stage"] = {
-        "init": {"name": read_card(init).get("name"), "version": read_card(init).get("version"),
-                 "sha256": sha256_file(init)},
-        "note": "the net is --init's, unchanged; fitted on the recordings: " + ", ".join(
-            k for k in ("split", "confidence") if k in block or k == "confidence" and block.get("folds"))}
+        "init": base, "note": "the net is --init's, unchanged; fitted on the recordings: " + ", ".join(fitted)}
     write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=force)
     return write_block(out, block)
 

@@ -37,9 +37,13 @@ ALONE_STEP = 3  # two-person scenes: each person alone rendered every ALONE_STEP
 RATES = (24.0, 25.0, 30.0)
 
 
+def cache_base() -> Path:
+    """wallcli's cache folder: $WALLCLI_CACHE, or ~/.cache/wallcli."""
+    return Path(os.environ.get("WALLCLI_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "wallcli"))
+
+
 def cache_root() -> Path:
-    base = os.environ.get("WALLCLI_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "wallcli")
-    return Path(base) / "pt"
+    return cache_base() / "pt"
 
 
 def recipe(*, seed: int, task: str = "count", domain: str = "wide", placement: str = "transfer",

@@ -200,11 +200,7 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
     ``cfg`` on the other folds (and ``sim_data``), exported, loaded with ``load(path)`` as the
     commands load it, answers the fold's clips. Each fold's answers are kept in ``work``: a rerun
     (after Ctrl-C, or to train the final model) skips the folds already answered."""
-    from dataclasses import replace
-
     from wallcli.io.writer import write_text_atomic
-    from wallcli.train.export import export_model
-    from wallcli.train.loop import train as run_training
 
     k = len(fold_dirs)
     answers: dict[str, dict[str, Any]] = {}
@@ -228,31 +224,34 @@ def cross_validate(cfg, fold_dirs: list[Path], sim_data: list[Path], recs: list[
         elif log:
             log(f"fold {f + 1}/{k}: training on {sum(len(r.starts) for r in recs if r not in members)} windows of "
                 f"{len(recs) - len(members)} clips, answering {len(members)} clips")
-        onnx = work / f"fold-{f}.onnx"
-        if cfg.epochs == 0:  # the net as it is: only the split (and the thresholds) come from the recordings
-            model = load(Path(cfg.init))
-            _attach_split(model, [r for r in recs if r not in members], split, split_sim)
-            got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
-                            "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
-            write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
-            answers.update(got)
-            continue
-        fcfg = replace(cfg, data=[d for i, d in enumerate(fold_dirs) if i != f] + list(sim_data), val=fold_dirs[f],
-                       out=onnx, checkpoint=work / f"fold-{f}-{ident}.ckpt.pt")
-        with bars() as bar:
-            res = run_training(fcfg, bar.event)
-        export_model(res["net"], res["dataset"].inputs, onnx,
-                     {"name": f"fold-{f}", "version": "0", "task": cfg.task, "classes": res["dataset"].classes,
-                      "preprocessing": cfg.preprocessing, "stride": 64, "training_data": {"folds": [str(d) for d in fcfg.data]},
-                      "training": {"fold": f, "of": k}, "validation": None}, force=True, seed=cfg.seed)
-        model = load(onnx)
+        # --epochs 0: the net as it is, only the split (and the thresholds) come from the recordings
+        model = load(Path(cfg.init) if cfg.epochs == 0 else
+                     _train_fold(cfg, f, fold_dirs, sim_data, work / f"fold-{f}.onnx", work / f"fold-{f}-{ident}.ckpt.pt", bars))
         _attach_split(model, [r for r in recs if r not in members], split, split_sim)
         got = {r.name: {"probs": [float(p) for p in clip_probabilities(model, r)],
                         "signal_db": clip_signal_db(model, r), "fold": f} for r in members}
         write_text_atomic(done, json.dumps({"identity": ident, "answers": got}), force=True)
-        fcfg.checkpoint_path().unlink(missing_ok=True)
+        (work / f"fold-{f}-{ident}.ckpt.pt").unlink(missing_ok=True)
         answers.update(got)
     return answers
+
+
+def _train_fold(cfg, f: int, fold_dirs: list[Path], sim_data: list[Path], onnx: Path, checkpoint: Path, bars) -> Path:
+    """Fold ``f``'s net: trained on the other folds (and ``sim_data``), validated on its own, exported."""
+    from dataclasses import replace
+
+    from wallcli.train.export import export_model
+    from wallcli.train.loop import train as run_training
+
+    fcfg = replace(cfg, data=[d for i, d in enumerate(fold_dirs) if i != f] + list(sim_data), val=fold_dirs[f],
+                   out=onnx, checkpoint=checkpoint)
+    with bars() as bar:
+        res = run_training(fcfg, bar.event)
+    export_model(res["net"], res["dataset"].inputs, onnx,
+                 {"name": f"fold-{f}", "version": "0", "task": cfg.task, "classes": res["dataset"].classes,
+                  "preprocessing": cfg.preprocessing, "stride": 64, "training_data": {"folds": [str(d) for d in fcfg.data]},
+                  "training": {"fold": f, "of": len(fold_dirs)}, "validation": None}, force=True, seed=cfg.seed)
+    return onnx
 
 
 def _split_data(recs: list[Recording], pair: list) -> tuple[np.ndarray, np.ndarray]:

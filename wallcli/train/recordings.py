@@ -13,12 +13,11 @@ in its clip's fold, so no fold's model has seen any part of the clips it answers
 from __future__ import annotations
 
 import hashlib
-import json
 import re
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
@@ -167,14 +166,6 @@ def load_recordings(folders: list[Path], cache: Path, *, progress: Callable[[str
     if not out:
         raise WallcliError(f"no labelled clips in {', '.join(map(str, folders))}")
     return out
-
-
-def describe(recs: list[Recording]) -> dict[str, Any]:
-    return {"clips": len(recs), "windows": int(sum(len(r.starts) for r in recs))}
-
-
-def dumps(obj: Any) -> str:
-    return json.dumps(obj, indent=1)
 
 
 def count_clips(folders: list[Path], task: str | None = None) -> int:
