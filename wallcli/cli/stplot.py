@@ -63,6 +63,7 @@ def stplot(
     from wallcli.io.writer import check_outputs, committed_together
     from wallcli.signal.stplot import compute_stplot
 
+    from wallcli.io.ahead import Ahead
     from wallcli.io.video import FrameTee
     from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.view import ViewCheck
@@ -74,8 +75,10 @@ def stplot(
     with open_video(input, threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
             # repeats left out, interlaced fields at one instant, overlays masked, as count reads it
-            plot = compute_stplot(FrameTee(CameraPipeline(reader, check), (check,)), roi=roi_t, bins=bins, mean=mean,
-                                  mean_seconds=mean_seconds, progress=advance, register=True, view=check)
+            # (its checks in a thread of their own, beside the projection: wallcli.io.ahead)
+            with Ahead(FrameTee(CameraPipeline(reader, check), (check,))) as frames:
+                plot = compute_stplot(frames, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds,
+                                      progress=advance, register=True, view=check)
     narrow = narrow_roi(plot.meta["roi"], plot.bins)
     if narrow:
         from wallcli.cli.output import warn

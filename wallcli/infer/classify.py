@@ -309,6 +309,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     decoded frame (:class:`wallcli.io.video.FrameTee`), e.g. to measure the SNR in the same decode.
     The view check rides on the same decode; its verdict is in the result (:func:`with_view`).
     """
+    from wallcli.io.ahead import Ahead
     from wallcli.io.video import FrameTee, open_video
     from wallcli.infer.stream import PlotThumbnail, RowStream
     from wallcli.signal.pipeline import CameraPipeline
@@ -327,13 +328,15 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
         # repeats (a DVR's padding) are missing samples: no tap, row or time sees them; nor do they
         # see an interlaced clip's fields at two instants, nor a burned-in overlay
         unique = CameraPipeline(reader, check)
-        rows = RowStream(FrameTee(unique, (check, blend, *taps)), roi=roi, bins=model.bins, fps=model.fps,
-                         progress=progress, vertical=keep_plot or "vertical" in model.input_names or corrections.light,
-                         register=corrections.shake)
-        for t, row in rows:
-            if thumb is not None:
-                thumb.push(t, row)
-            classifier.push(t, stream_row(row, rows), rows.ref)
+        # the checks and taps in a thread of their own, beside the projection and the nets
+        with Ahead(FrameTee(unique, (check, blend, *taps))) as frames:
+            rows = RowStream(frames, roi=roi, bins=model.bins, fps=model.fps, progress=progress,
+                             vertical=keep_plot or "vertical" in model.input_names or corrections.light,
+                             register=corrections.shake)
+            for t, row in rows:
+                if thumb is not None:
+                    thumb.push(t, row)
+                classifier.push(t, stream_row(row, rows), rows.ref)
         if classifier.empty:
             check.fps = float(reader.info.fps or 0.0) or None
             raise _too_short_video(str(source), check, model, unique.decoded)

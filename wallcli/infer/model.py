@@ -115,6 +115,9 @@ class Model:
             import onnxruntime as ort
 
             opts = ort.SessionOptions()
+            # a window comes every second or two, between frames the decoder and the checks need
+            # both cores: onnxruntime's pool must not spin waiting for the next one
+            opts.add_session_config_entry("session.intra_op.allow_spinning", "0")
             if self.threads > 0:
                 opts.intra_op_num_threads = self.threads
                 opts.inter_op_num_threads = 1

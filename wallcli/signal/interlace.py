@@ -34,6 +34,8 @@ T_DECIDE = 8.0  # t statistic of the slope
 TAU = 1.0  # seconds: the running means' time constant
 MIN_FRAMES = 12
 MIN_DELTA = 0.3  # frames: a smaller offset between the fields is too small to correct
+PROGRESSIVE = 0.02  # a slope held under this by T_DECIDE standard errors over PROGRESSIVE_AFTER
+PROGRESSIVE_AFTER = 4.0  # seconds at least: shown progressive, the clip is not read further
 OFFSETS = (-1.0, -0.5, 0.5, 1.0)  # what delta is snapped to (1/2: a camera's fields; 1: fields a frame apart)
 
 
@@ -45,6 +47,8 @@ class InterlaceFilter:
         self.reader = reader
         self.delta: float | None = None  # the bottom field's offset from the top one, frames
         self.since: float | None = None  # time of the first frame corrected
+        self.progressive = False  # shown progressive: nothing more is read
+        self._fps = 30.0
         self._seen: deque = deque(maxlen=5)  # (top field at the bottom rows, bottom field) of the last frames
         self._mean = None  # running means of the ratio and the rate
         self._n = 0
@@ -56,15 +60,15 @@ class InterlaceFilter:
     def _fields(self, y: np.ndarray):
         """(top field at the bottom rows, bottom field; bottom field at the top rows, top field)."""
         step = max(1, -(-y.shape[1] // MAX_COLUMNS))
-        a = y[:, ::step]
-        n = min((a.shape[0] - 1) // 2, a.shape[0] // 2 - 1)
+        n = min((y.shape[0] - 1) // 2, y.shape[0] // 2 - 1)
         i = np.arange(0, n, max(1, -(-n // MAX_PAIRS)))  # groups of rows 2i..2i+3 (every row of them read)
-        top, bottom = a[2 * i].astype(np.float32), a[2 * i + 1].astype(np.float32)
-        top1, bottom1 = a[2 * i + 2].astype(np.float32), a[2 * i + 3].astype(np.float32)
+        # one gather of the four rows of every group (lattice columns), one conversion
+        g = y[(2 * i[:, None] + np.arange(4)).ravel(), ::step].astype(np.float32).reshape(len(i), 4, -1)
+        top, bottom, top1, bottom1 = g[:, 0], g[:, 1], g[:, 2], g[:, 3]
         return np.maximum(0.5 * (top + top1), 1.0), bottom, np.maximum(0.5 * (bottom + bottom1), 1.0), top1
 
     def _observe(self, y: np.ndarray, fps: float) -> None:
-        if y.shape[0] < 8 or self.delta is not None:  # decided: nothing more to read
+        if y.shape[0] < 8 or self.delta is not None or self.progressive:  # decided: nothing more to read
             return
         cur = self._fields(y)
         if self._seen and cur[0].shape != self._seen[-1][0].shape:
@@ -73,6 +77,7 @@ class InterlaceFilter:
         if len(self._seen) < 5:
             return
         self._n += 1
+        self._fps = fps
         a = max(1.0 / (TAU * fps), 1.0 / self._n)
         for side in (0, 1):  # the bottom field against the top, then the top against the bottom
             far0, before, (ref, other), after, far1 = (f[2 * side] if i != 2 else f[2 * side:2 * side + 2]
@@ -102,6 +107,11 @@ class InterlaceFilter:
             ses.append(np.sqrt(max(syy - sxy * sxy / sxx, 0.0) / n / sxx))
             ivs.append(szy / szx)
         slope, se = (slopes[0] - slopes[1]) / 2, np.hypot(*ses) / 2
+        if se > 0 and abs(slope) + T_DECIDE * se < PROGRESSIVE and self._n >= PROGRESSIVE_AFTER * self._fps:
+            # the light's changes have shown the rows of both fields at one instant, beyond doubt:
+            # a camera's fields read a slope near 1/2, flattened by noise but never to this
+            self.progressive = True
+            return
         if slope == 0 or (se > 0 and abs(slope) < T_DECIDE * se):
             return
         # the size: the rate's own noise flattens the slope; measured against the rate read on

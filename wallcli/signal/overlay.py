@@ -43,6 +43,9 @@ BEFORE, AFTER = 3, 2  # frame pairs either side of a step in which its box must 
 PAD = 2  # samples: a step's box widened by this before the pairs either side are read
 MAX_BOX = 0.08  # of the frame's area: an overlay's step (some digits), or a line of text, is no larger
 STILL_RUN = 0.5  # seconds over which a static text's samples have hardly changed
+STATIC_EVERY = 1.0  # seconds between looks for still text: it stays where it is, and a look costs
+# a median over a wide neighbourhood of the whole frame (3-6 ms at 640 samples; at 8 frames apart it
+# was a third of the overlay check's time on a 1080p export, bench/RESULTS.md)
 STILL_REL = 0.2  # hardly: by under this share of the frame's typical change (and 0.05 codes: not at all)
 STATIC_CONTRAST = 24.0  # 8-bit codes from their neighbourhood's median (a codec leaves wall texture still too)
 STATIC_PIXELS = 10  # such samples in a line of text
@@ -87,7 +90,7 @@ class OverlayFilter:
         self._taken = None  # samples under a box (their steps are masked already)
         self._run = None  # per sample: its running mean frame-to-frame change (codes)
         self._run_n = 0
-        self._calm = None  # per sample: frame pairs since it last changed by a step's size
+        self._stepped = None  # per sample: the _run_n at which it last changed by a step's size
         self._contrast = ABS_STEP  # codes: what a step changes (K_STEP noise sigmas, ABS_STEP at least)
 
     def __getattr__(self, name: str):
@@ -123,8 +126,8 @@ class OverlayFilter:
         # the noise of a difference: a codec zeroes most differences of a still wall, and the
         # median alone then reads its noise as a fraction of what the rest of the pixels show
         # (read on a lattice: a sixteenth of the samples tell the noise as well)
-        few = d[::4, ::4].astype(np.float32)
-        self._sig.append(max(1.4826 * float(np.median(few)), float(np.percentile(few, 90)) / 1.645))
+        median, p90 = _median_p90(d[::4, ::4])
+        self._sig.append(max(1.4826 * median, p90 / 1.645))
         sigma = float(np.median(self._sig))
         self._contrast = max(K_STEP * sigma, ABS_STEP)
         big = d > self._contrast
@@ -134,16 +137,13 @@ class OverlayFilter:
         # mean): a codec touches a still text by a code now and then, the wall's noise always
         if self._run is None or self._run.shape != d.shape:
             self._run, self._run_n = np.zeros(d.shape, np.float32), 0
-            self._calm = np.zeros(d.shape, np.uint16)
+            self._stepped = np.zeros(d.shape, np.int32)
         self._run_n += 1
-        # and frames since it last stepped: a moving text's strokes step every few frames
-        np.minimum(self._calm, 60000, out=self._calm)
-        self._calm += 1
-        self._calm[big] = 0
+        # and when it last stepped (the frames since, in _static): a moving text's strokes step every few frames
+        np.copyto(self._stepped, self._run_n, where=big)
         fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
-        a = np.float32(max(1.0 / (STILL_RUN * fps), 1.0 / self._run_n))
-        self._run *= 1 - a
-        self._run += a * d
+        a = max(1.0 / (STILL_RUN * fps), 1.0 / self._run_n)
+        cv2.accumulateWeighted(d, self._run, a)  # (1 - a) run + a d, one pass outside the GIL
         if self._taken is not None and self._taken.shape == big.shape:
             big &= ~self._taken
         self._big.append((self._index, big if big.any() else None))
@@ -181,6 +181,10 @@ class OverlayFilter:
             found.append((x0, y0, x1, y1))
         return found
 
+    def _static_every(self) -> int:
+        fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
+        return max(1, round(STATIC_EVERY * fps))
+
     def _static(self) -> list[tuple[int, int, int, int]]:
         """Boxes (sample coordinates) of text that has hardly changed over STILL_RUN seconds."""
         import cv2
@@ -189,14 +193,22 @@ class OverlayFilter:
         if self._run_n < max(2 * STILL_RUN * fps, 4):
             return []
         typical = float(np.median(self._run[::4, ::4]))
-        long = (self._run <= max(STILL_REL * typical, 0.05)) & (self._calm >= 2 * STILL_RUN * fps)
+        calm = self._run_n - self._stepped  # frame pairs since each sample last stepped
+        long = (self._run <= max(STILL_REL * typical, 0.05)) & (calm >= 2 * STILL_RUN * fps)
         if not long.any() or long.mean() > MAX_STILL_SHARE:
             return []
         s = self._prev.astype(np.float32)
         # against the wall about it: a neighbourhood twice a line of text's height (a bold
         # stroke is its own median in a small one)
-        k = max(5, (2 * s.shape[0] * TEXT_LINE) // 2 * 2 + 1)
-        ground = cv2.medianBlur(np.clip(s, 0, 255).astype(np.uint8), int(k)).astype(np.float32)
+        k = int(max(5, (2 * s.shape[0] * TEXT_LINE) // 2 * 2 + 1))
+        # the median only where it is asked, in the band of still samples and half a kernel about
+        # it (the same values: every one's whole neighbourhood is inside, the frame's edges too)
+        rows, cols = np.flatnonzero(long.any(axis=1)), np.flatnonzero(long.any(axis=0))
+        r0, r1 = max(int(rows[0]) - k // 2, 0), min(int(rows[-1]) + k // 2 + 1, s.shape[0])
+        c0, c1 = max(int(cols[0]) - k // 2, 0), min(int(cols[-1]) + k // 2 + 1, s.shape[1])
+        eight = self._prev if self._prev.dtype == np.uint8 else np.clip(s, 0, 255).astype(np.uint8)
+        ground = np.zeros_like(s)
+        ground[r0:r1, c0:c1] = cv2.medianBlur(np.ascontiguousarray(eight[r0:r1, c0:c1]), k)
         stands_out = np.abs(s - ground) > max(self._contrast, STATIC_CONTRAST)
         cand = long & stands_out
         if self._taken is not None and self._taken.shape == cand.shape:
@@ -268,7 +280,7 @@ class OverlayFilter:
             j = self._index - AFTER
             if j >= 1 and self._last is not None:
                 boxes = self._judge(j)
-                if self._run is not None and self._index % 8 == 0:
+                if self._run is not None and self._index % self._static_every() == 0:
                     boxes += self._static()
                 if boxes:
                     self._take(boxes, self._waiting[0].time)
@@ -304,6 +316,27 @@ def merged(items) -> list[dict]:
         else:
             groups.append([box, first])
     return [{"box": [int(v) for v in b], "kind": "overlay", "from": f} for b, f in groups]
+
+
+def _median_p90(a: np.ndarray) -> tuple[float, float]:
+    """np.median and np.percentile(., 90) of ``a``; for 8-bit differences read off their histogram
+    (exact: order statistics of integers), a tenth of sorting them."""
+    if a.dtype != np.uint8:
+        a = a.astype(np.float32)
+        return float(np.median(a)), float(np.percentile(a, 90))
+    import cv2
+
+    cum = np.cumsum(cv2.calcHist([np.ascontiguousarray(a)], [0], None, [256], [0, 256]).ravel())
+    n = a.size
+
+    def kth(k: int) -> float:  # the k-th smallest (0-based)
+        return float(np.searchsorted(cum, k, side="right"))
+
+    median = kth((n - 1) // 2) if n % 2 else 0.5 * (kth(n // 2 - 1) + kth(n // 2))
+    at = 0.9 * (n - 1)
+    lo = int(np.floor(at))
+    p90 = kth(lo) + (at - lo) * (kth(min(lo + 1, n - 1)) - kth(lo))
+    return median, p90
 
 
 def _text_step(before: np.ndarray, after: np.ndarray, changed: np.ndarray, contrast: float) -> bool:
