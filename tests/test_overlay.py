@@ -153,3 +153,52 @@ def test_the_clocks_first_steps_before_it_is_recognised_are_taken_back(tmp_path,
     assert got["view"]["masked"], "the overlay was not found"
     assert got["view"]["usable"], got["view"]["reason"]
     assert "moving object" not in got["view"]["issues"]
+
+
+def _gray_clock(n, fps=30, seed=1):
+    """A noisy flat 96x72 wall with the clock (a step at every second) as a reader of n gray frames."""
+    from types import SimpleNamespace
+
+    from wallcli.io.planes import Planes
+    from wallcli.io.video import Frame
+    from wallcli.sim.overlay import text_mask
+
+    rng = np.random.default_rng(seed)
+    wall = 120 + 20 * rng.random((72, 96))
+
+    def frame(i):
+        y = wall + rng.normal(0, 2, wall.shape)
+        y[text_mask(72, 96, i / fps)] = 235
+        return Frame(i, i / fps, Planes(y.astype(np.float32), None, None, "gray"))
+
+    return SimpleNamespace(info=SimpleNamespace(fps=fps), frames=lambda: (frame(i) for i in range(n)))
+
+
+def test_a_clock_found_in_the_first_seconds_is_masked_from_the_clips_start():
+    """The seconds digit is recognised at its first step (1 s) or later; the frames before are
+    held back (decoded once), so the step at 1 s and every frame before it are masked too."""
+    from wallcli.signal.overlay import OverlayFilter
+
+    f = OverlayFilter(_gray_clock(150))
+    out = list(f.frames())
+    assert len(out) == 150 and [o.time for o in out] == [i / 30 for i in range(150)]
+    masked = f.masked()
+    # found at its first step (1 s) or later, masked from the first frame
+    assert masked and all(m["masked_from"] == 0.0 and m["from"] >= 1.0 for m in masked)
+    x, y, w, h = masked[0]["box"]
+    box = np.stack([o.planes.y[y:y + h, x:x + w] for o in out[:60]]).astype(np.float32)
+    # no step inside the box at 1 s (frame 30) nor anywhere in the first 2 s (a digit's step: about
+    # 100 codes): what is left follows the light about the box (here its noise, under 2 codes);
+    # before, frames 0-31 were handed on unmasked
+    assert float(np.abs(np.diff(box, axis=0)).max()) < 5.0
+
+
+def test_the_start_held_back_is_bounded():
+    """At most HOLD_SECONDS of frames wait, whatever the clip's length: memory stays flat."""
+    from wallcli.signal import overlay
+
+    f = overlay.OverlayFilter(_gray_clock(600))
+    most = 0
+    for i, _ in enumerate(f.frames()):
+        most = max(most, len(f._waiting))
+    assert i == 599 and most <= overlay.HOLD_SECONDS * 30 + overlay.AFTER + 2
