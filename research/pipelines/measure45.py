@@ -11,6 +11,13 @@ that rule, not picked by their answers). Kinds:
          (wallcli.sim.isp.RecursiveFilter(0.65)), FFV1; the clean copy goes the same way
          without the blend
   clock23  as clock, both copies written at CRF 23 (a recorder's export)
+  clocklo  the clock and name burned in at the clip's own size (HH:MM:SS, 6-8 px tall), then
+           upscaled with it to 640x480, CRF 0 (blurred strokes: no longer one flat value; the
+           issue's late, partial finds); the clean copy is clock's
+  clockmin as clock, the clock started at 16:00:51 + i s (clip i = 0..7): its tens-of-seconds,
+           minute (and date line's) digits first step at 9 - i s, after the units had stepped
+           every second (a recorder's clock does not start at :00 with the clip)
+  clockmin23 the same at CRF 23 (the first four clips; the clean copy is clock23's)
 
 Count and activity run on every copy as `wallcli scan` runs them (wallcli.batch.analyse: one
 decode, the single commands' answers). A case (a clip, a kind and a task) is kept when the
@@ -51,11 +58,11 @@ def chosen() -> list[dict]:
     return out
 
 
-def _clock(src: Path, dst: Path, burn: bool, crf: int = 0) -> None:
+def _clock(src: Path, dst: Path, burn: bool, crf: int = 0, native: bool = False, start: int = 0) -> None:
     import av
     import cv2
 
-    from wallcli.sim.overlay import text_mask
+    from wallcli.sim.overlay import EPOCH, text_mask
 
     W, H = SIZE
     tmp = dst.with_name("tmp_" + dst.name)
@@ -71,10 +78,17 @@ def _clock(src: Path, dst: Path, burn: bool, crf: int = 0) -> None:
             a = f.to_ndarray(format="yuv420p")
             h, w = f.height, f.width
             planes = [a[:h], *a[h:].reshape(2, h // 2, w // 2)]
+            if burn and native:  # burned in at the clip's own size, then upscaled with it (blurred strokes)
+                m = text_mask(h, w, float(f.time) - t0, name=NAME, start=EPOCH + start)
+                planes = [np.array(p) for p in planes]
+                planes[0][m] = 235
+                mc = m.reshape(h // 2, 2, w // 2, 2).any(axis=(1, 3))
+                planes[1][mc] = 128
+                planes[2][mc] = 128
             up = [np.clip(np.rint(cv2.resize(p.astype(np.float32), s, interpolation=cv2.INTER_LINEAR)), 0, 255)
                   .astype(np.uint8) for p, s in zip(planes, (SIZE, (W // 2, H // 2), (W // 2, H // 2)))]
-            if burn:
-                m = text_mask(H, W, float(f.time) - t0, name=NAME)
+            if burn and not native:
+                m = text_mask(H, W, float(f.time) - t0, name=NAME, start=EPOCH + start)
                 up[0][m] = 235
                 mc = m.reshape(H // 2, 2, W // 2, 2).any(axis=(1, 3))
                 up[1][mc] = 128
@@ -101,6 +115,9 @@ def make(args) -> None:
                                ("clock", f"{stem}_clock.mp4", lambda d: _clock(src, d, True)),
                                ("clock23", f"{stem}_clock23_clean.mp4", lambda d: _clock(src, d, False, 23)),
                                ("clock23", f"{stem}_clock23.mp4", lambda d: _clock(src, d, True, 23)),
+                               ("clocklo", f"{stem}_clocklo.mp4", lambda d: _clock(src, d, True, native=True)),
+                               ("clockmin", f"{stem}_clockmin.mp4", lambda d: _clock(src, d, True, start=51 + i)),
+                               ("clockmin23", f"{stem}_clockmin23.mp4", lambda d: _clock(src, d, True, 23, start=51 + i)),
                                ("tnr", f"{stem}_tnr_clean.mkv", lambda d: _alter(src, d, "clean", 0.0, i)),
                                ("tnr", f"{stem}_tnr.mkv", lambda d: _alter(src, d, "tnr", BLEND, i))):
             dst = out / name
@@ -130,7 +147,7 @@ def run(args) -> None:
         done = {json.loads(line)["file"] for line in path.read_text().splitlines() if line.strip()}
     with open(path, "a") as f:
         for e in index:
-            if e["file"] in done or (args.kind and e["kind"] not in args.kind):
+            if e["file"] in done or (args.kind and e["kind"] not in args.kind) or not (out / e["file"]).exists():
                 continue
             try:
                 res = analyse(str(out / e["file"]), ("count", "activity"), models)
@@ -171,14 +188,14 @@ def table(args) -> None:
             r = json.loads(line)
             res[r["file"]] = r
         total = kept = 0
-        for kind in ("clock", "clock23", "tnr"):
+        for kind in ("clock", "clock23", "clocklo", "clockmin", "clockmin23", "tnr"):
             for task in ("count", "activity"):
                 n = k = 0
                 miss = []
                 for e in index:
-                    if e["kind"] != kind or e["clean"]:
+                    if e["kind"] != kind or e["clean"] or not (out / e["file"]).exists():
                         continue
-                    clean = e["file"].replace(".mp4", "_clean.mp4").replace(".mkv", "_clean.mkv")
+                    clean = e["file"].replace(".mp4", "_clean.mp4").replace(".mkv", "_clean.mkv").replace("_clocklo", "_clock").replace("_clockmin23", "_clock23").replace("_clockmin", "_clock")
                     c, a = res.get(clean), res.get(e["file"])
                     if not c or not a:
                         continue
@@ -200,7 +217,7 @@ def main() -> None:
     ap.add_argument("step", choices=("make", "run", "table"))
     ap.add_argument("--out", required=True)
     ap.add_argument("--tag", default="after")
-    ap.add_argument("--kind", action="append", choices=("clock", "clock23", "tnr"), default=[])
+    ap.add_argument("--kind", action="append", choices=("clock", "clock23", "clocklo", "clockmin", "clockmin23", "tnr"), default=[])
     ap.add_argument("--clips", type=int, default=N_CLIPS)
     ap.add_argument("--detail", action="store_true")
     args = ap.parse_args()

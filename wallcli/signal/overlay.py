@@ -11,6 +11,10 @@ the step, beyond the wall's spread: a codec's keyframe or a shadow stepping in o
 values the wall has). A text that moves, or any object, changes its box in the frames next to
 the step and is never taken for one.
 
+A step found grows to its whole line of text: the samples of its rows either side that stand out
+from the wall in the step's text colour, as far as they run on (a clock's other digits step later,
+after a minute or an hour, and its date never within a clip).
+
 Text that never changes (a camera name, the clock's date) is found by the same freezing: samples
 that have hardly changed over ``STILL_RUN`` seconds (a codec touches them now and then), where the
 wall's own noise keeps most of the frame changing, that stand out from their neighbourhood as a text's strokes do, and most of
@@ -192,6 +196,53 @@ class OverlayFilter:
             found.append((x0, y0, x1, y1))
         return found
 
+    def _line(self, boxes) -> list[tuple[int, int, int, int]]:
+        """Boxes (sample coordinates) of the rest of the text line each step box in ``boxes`` lies
+        in: the samples of its rows, either side, that stand out from the wall in the step's text
+        colour, as far as they run on with gaps under the line's height (a clock's other digits
+        and its date step later, or never within the clip; the static finder misses them where a
+        codec holds most of the frame still)."""
+        import cv2
+
+        s = self._frames[-(AFTER + 1)].astype(np.float32)  # the frame after the step
+        h, w = s.shape
+        k = int(max(5, (2 * h * TEXT_LINE) // 2 * 2 + 1))
+        thr = max(self._contrast, STATIC_CONTRAST)
+        found = []
+        cover = np.zeros((h, w), bool) if self._taken is None or self._taken.shape != (h, w) else self._taken.copy()
+        for x0, y0, x1, y1 in boxes:
+            cover[y0:y1, x0:x1] = True
+        for x0, y0, x1, y1 in boxes:
+            b0, b1 = max(y0 - k, 0), min(y1 + k, h)
+            ground = cv2.medianBlur(np.clip(s[b0:b1], 0, 255).astype(np.uint8), k).astype(np.float32)
+            band, ground = s[y0:y1], ground[y0 - b0:y1 - b0]
+            out = np.abs(band - ground) > thr
+            if int(out[:, x0:x1].sum()) < MIN_PIXELS:
+                continue
+            colour = float(np.median(band[:, x0:x1][out[:, x0:x1]]))
+            cols = (out & (np.abs(band - colour) <= STEP_FLAT)).any(axis=0)
+            gap = y1 - y0
+            lo = x0
+            while True:
+                near = np.flatnonzero(cols[max(lo - gap, 0):lo])
+                if not near.size:
+                    break
+                lo = max(lo - gap, 0) + int(near[0])
+            hi = x1
+            while True:
+                near = np.flatnonzero(cols[hi:min(hi + gap, w)])
+                if not near.size:
+                    break
+                hi = hi + int(near[-1]) + 1
+            most = int(MAX_BOX * h * w) // max(gap, 1)  # wide lines in pieces, each an overlay's box
+            for a, b in ((max(lo - PAD, 0), x0), (x1, min(hi + PAD, w))):
+                for c in range(a, b, max(most, 1)):
+                    e = min(c + most, b)
+                    if e > c and not cover[y0:y1, c:e].all():
+                        found.append((c, y0, e, y1))
+                        cover[y0:y1, c:e] = True
+        return found
+
     def _static(self) -> list[tuple[int, int, int, int]]:
         """Boxes (sample coordinates) of text that has hardly changed over STILL_RUN seconds."""
         import cv2
@@ -300,6 +351,8 @@ class OverlayFilter:
             j = self._index - AFTER
             if j >= 1 and self._frame(j - 1, fill=False) is not None:
                 boxes = self._judge(j)
+                if boxes:
+                    boxes += self._line(boxes)
                 if self._run is not None and self._index % 8 == 0:
                     boxes += self._static()
                 if boxes:
