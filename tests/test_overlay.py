@@ -153,3 +153,109 @@ def test_the_clocks_first_steps_before_it_is_recognised_are_taken_back(tmp_path,
     assert got["view"]["masked"], "the overlay was not found"
     assert got["view"]["usable"], got["view"]["reason"]
     assert "moving object" not in got["view"]["issues"]
+
+
+def _gray_clock(n, fps=30, seed=1):
+    """A noisy flat 96x72 wall with the clock (a step at every second) as a reader of n gray frames."""
+    from types import SimpleNamespace
+
+    from wallcli.io.planes import Planes
+    from wallcli.io.video import Frame
+    from wallcli.sim.overlay import text_mask
+
+    rng = np.random.default_rng(seed)
+    wall = 120 + 20 * rng.random((72, 96))
+
+    def frame(i):
+        y = wall + rng.normal(0, 2, wall.shape)
+        y[text_mask(72, 96, i / fps)] = 235
+        return Frame(i, i / fps, Planes(y.astype(np.float32), None, None, "gray"))
+
+    return SimpleNamespace(info=SimpleNamespace(fps=fps), frames=lambda: (frame(i) for i in range(n)))
+
+
+def test_a_clock_found_in_the_first_seconds_is_masked_from_the_clips_start():
+    """The seconds digit is recognised at its first step (1 s) or later; the frames before are
+    held back (decoded once), so the step at 1 s and every frame before it are masked too."""
+    from wallcli.signal.overlay import OverlayFilter
+
+    f = OverlayFilter(_gray_clock(150))
+    out = list(f.frames())
+    assert len(out) == 150 and [o.time for o in out] == [i / 30 for i in range(150)]
+    masked = f.masked()
+    # found at its first step (1 s) or later, masked from the first frame
+    assert masked and all(m["masked_from"] == 0.0 and m["from"] >= 1.0 for m in masked)
+    x, y, w, h = masked[0]["box"]
+    box = np.stack([o.planes.y[y:y + h, x:x + w] for o in out[:60]]).astype(np.float32)
+    # no step inside the box at 1 s (frame 30) nor anywhere in the first 2 s (a digit's step: about
+    # 100 codes): what is left follows the light about the box (here its noise, under 2 codes);
+    # before, frames 0-31 were handed on unmasked
+    assert float(np.abs(np.diff(box, axis=0)).max()) < 5.0
+
+
+def test_the_start_held_back_is_bounded():
+    """At most HOLD_SECONDS of frames wait, whatever the clip's length: memory stays flat."""
+    from wallcli.signal import overlay
+
+    f = overlay.OverlayFilter(_gray_clock(600))
+    most = 0
+    for i, _ in enumerate(f.frames()):
+        most = max(most, len(f._waiting))
+    assert i == 599 and most <= overlay.HOLD_SECONDS * 30 + overlay.AFTER + 2
+
+
+def test_a_steps_whole_text_line_is_masked_from_the_start():
+    """On a wall a codec holds still (over half the frame unchanged, where the static finder says
+    nothing), only the digits that step are found by their steps: the clock at 16:00:51 stepped its
+    seconds from 1 s, and its tens of seconds and minute first at 9 s, after the start held back;
+    before, they were masked only from 9 s. A step now grows to its whole line of text (the date
+    and the time), masked from the clip's start."""
+    from types import SimpleNamespace
+
+    from wallcli.io.planes import Planes
+    from wallcli.io.video import Frame
+    from wallcli.signal.overlay import OverlayFilter
+    from wallcli.sim.overlay import EPOCH, text_mask
+
+    rng = np.random.default_rng(2)
+    wall = np.round(110 + 20 * rng.random((60, 80)).repeat(8, 0).repeat(8, 1))
+
+    def frame(i):
+        y = np.array(wall)
+        y[text_mask(480, 640, i / 30, start=EPOCH + 51)] = 235
+        return Frame(i, i / 30, Planes(y.astype(np.uint8), None, None, "gray"))
+
+    reader = SimpleNamespace(info=SimpleNamespace(fps=30), frames=lambda: (frame(i) for i in range(300)))
+    f = OverlayFilter(reader)
+    out = list(f.frames())
+    masked = f.masked()
+    assert masked and all(m["from"] < 2 and m["masked_from"] == 0.0 for m in masked), masked
+    top = [m["box"] for m in masked if m["box"][1] < 60]
+    # the line "2026-11-26 16:00:51" runs from x = 13 to about 450: all of it (before: the seconds, 55 px)
+    assert min(x for x, _, _, _ in top) < 20 and max(x + w for x, _, w, _ in top) > 440
+    band = np.stack([o.planes.y[10:70, :460] for o in out]).astype(np.float32)
+    assert float(np.abs(np.diff(band, axis=0)).max()) < 1.0  # no step left anywhere in the line
+
+
+def test_simulate_starts_the_clock_where_asked(tmp_path):
+    """--clock-start: a recorder's clock does not read :00 at the clip's start; from 16:00:58 its
+    tens of seconds and minute step at 2 s (a wider change than a seconds digit's)."""
+    from wallcli.cli.app import main
+    from wallcli.sim.overlay import EPOCH, text_mask
+
+    clip = tmp_path / "late.mkv"
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "-o", str(clip), *SIM[:-1], "3", "--overlay", "--clock-start", "16:00:58"])
+    assert exc.value.code in (0, None)
+    assert json.loads(clip.with_suffix(".json").read_text())["clock_start"] == "16:00:58"
+    with av.open(str(clip)) as c:
+        f = [x.to_ndarray(format="rgb24").astype(int) for x, _ in zip(c.decode(video=0), range(61))]
+    start = EPOCH - EPOCH % 86400 + 16 * 3600 + 58
+    for i in (0, 30, 60):  # the frames hold the clock's text from 16:00:58 on
+        assert f[i][text_mask(120, 160, i / 30, start=start)].min() > 200
+    # and not the default clock's: at 2 s it reads 16:00:02, whose strokes are not all drawn
+    other = text_mask(120, 160, 2.0) & ~text_mask(120, 160, 2.0, start=start)
+    assert other.any() and f[60][other].min() < 200
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "-o", str(tmp_path / "bad.mkv"), *SIM, "--overlay", "--clock-start", "25:00:00"])
+    assert exc.value.code not in (0, None)

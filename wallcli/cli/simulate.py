@@ -105,6 +105,9 @@ def simulate(
                                  "px wide or more) at the top left, white and flat, changing every second."),
     camera_name: Optional[str] = typer.Option(None, "--camera-name", help="With --overlay: also burn in this fixed "
                                               "text at the bottom right (e.g. 'CAM 01')."),
+    clock_start: Optional[str] = typer.Option(None, "--clock-start", help="With --overlay: the clock's reading at the "
+                                              "clip's start, HH:MM:SS (default 16:00:00; e.g. 16:00:53 steps its tens "
+                                              "of seconds, minute and date digits mid-clip, not only the seconds)."),
     interlace: Optional[str] = typer.Option(None, "--interlace", help="tff | bff: render at twice --fps and weave "
                                             "the frames two by two into interlaced ones, the top (tff) or the "
                                             "bottom (bff) field first, half a frame apart."),
@@ -196,13 +199,20 @@ def simulate(
         raise UsageError(f"--interlace must be tff or bff (got {interlace!r})")
     if camera_name is not None and not overlay:
         raise UsageError("--camera-name is text of the --overlay; give --overlay too")
+    if clock_start is not None:
+        if not overlay:
+            raise UsageError("--clock-start is the --overlay's clock; give --overlay too")
+        parts = clock_start.split(":")
+        if len(parts) != 3 or not all(p.isdigit() for p in parts) or not (
+                int(parts[0]) < 24 and int(parts[1]) < 60 and int(parts[2]) < 60):
+            raise UsageError(f"--clock-start must be HH:MM:SS (got {clock_start!r})")
     _video(**locals())
 
 
 def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, world, domain, dist, spd, level, iso_gain,
            read_noise, sensor_pixels, prnu, gamma, noise_scale, drift, flicker, mains, ae_steps, shake, nuisances,
            preview, json_out, force, acts, suffix, spp, rolling_shutter=None, dup_frames=None, tnr=None, awb_drift=None,
-           overlay=False, camera_name=None, interlace=None, **_):
+           overlay=False, camera_name=None, interlace=None, clock_start=None, **_):
     import json
 
     import numpy as np
@@ -243,7 +253,10 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
         scene = sample_scene(seed, cfg)
     n = len(scene.times) // (2 if interlace else 1)
     from wallcli.sim.dvr import dup_mask, pad_frames
-    from wallcli.sim.overlay import interlaced, stamp_rgb
+    from wallcli.sim.overlay import EPOCH, interlaced, stamp_rgb
+
+    hh, mm, ss = (int(p) for p in (clock_start or "16:00:00").split(":"))
+    start = EPOCH - EPOCH % 86400 + 3600 * hh + 60 * mm + ss  # the clock's reading at the clip's start
 
     # its own stream of the seed: the same seed with and without --dup-frames renders the same frames
     copies = dup_mask(n, float(dup_frames or 0.0), np.random.default_rng([seed, 0xD0B]))
@@ -257,14 +270,14 @@ def _video(output, people, activity, seed, duration, fps, w, h, grid_rc, crf, wo
             with progress("simulate", n) as advance:
                 frames = interlaced(scene.frames(), interlace) if interlace else scene.frames()
                 for i, frame in enumerate(pad_frames(frames, copies)):
-                    vw.write(stamp_rgb(frame, i / fps, name=camera_name) if overlay else frame)
+                    vw.write(stamp_rgb(frame, i / fps, name=camera_name, start=start) if overlay else frame)
                     advance(1)
         truth = scene.truth()
         truth.update(video=output.name, codec=codec, crf=crf if codec == "libx264" else None)
         if dup_frames:
             truth.update(dup_frames=float(dup_frames), duplicated=int(copies.sum()))
         if overlay:
-            truth.update(overlay="clock", camera_name=camera_name)
+            truth.update(overlay="clock", camera_name=camera_name, clock_start=f"{hh:02d}:{mm:02d}:{ss:02d}")
         if interlace:  # the truth's per-frame positions are the top fields' (even-numbered renders)
             for person in truth.get("persons", []):
                 person["positions"] = person["positions"][0::2][:n]

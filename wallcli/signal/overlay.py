@@ -11,6 +11,10 @@ the step, beyond the wall's spread: a codec's keyframe or a shadow stepping in o
 values the wall has). A text that moves, or any object, changes its box in the frames next to
 the step and is never taken for one.
 
+A step found grows to its whole line of text: the samples of its rows either side that stand out
+from the wall in the step's text colour, as far as they run on (a clock's other digits step later,
+after a minute or an hour, and its date never within a clip).
+
 Text that never changes (a camera name, the clock's date) is found by the same freezing: samples
 that have hardly changed over ``STILL_RUN`` seconds (a codec touches them now and then), where the
 wall's own noise keeps most of the frame changing, that stand out from their neighbourhood as a text's strokes do, and most of
@@ -21,7 +25,10 @@ scaled by how the wall's light around the box has changed since: no analysis (th
 the plots, the SNR, the ROI) ever sees the step, while the box follows the light of the wall about
 it. The filled planes are float32 (the fill is a gain, never rounded). Frames wait ``AFTER``
 frames before they are handed on (they are the decoder's buffers, not copies), so memory stays
-flat whatever the length.
+flat whatever the length. The clip's first ``HOLD_SECONDS`` (at most ``HOLD_BYTES`` of decoded
+picture) wait until then: a box found in them is masked from the clip's first frame, so a clock's
+steps before it was recognised are never read as signal or as a moving object (decoded once,
+never re-read; ``view.masked``'s ``from`` is then the clip's start).
 """
 
 from __future__ import annotations
@@ -59,15 +66,20 @@ MAX_TOTAL = 0.2  # of the frame's area: boxes beyond it are not taken (the check
 MAX_REGIONS = 32
 RING = 3  # source pixels about a box whose light the box follows
 HISTORY = 16  # recent noise sigmas whose median the thresholds use
+HOLD_SECONDS = 8.0  # the clip's first seconds are held back (decoded once, not re-read), so that an
+# overlay found in them is masked from the clip's start (a clock's digits were found 0.9-7 s in;
+# before, their steps were read as signal or as a moving object)
+HOLD_BYTES = 192 << 20  # and at most this much decoded picture (1080p 4:2:0: about 60 frames)
 
 
 @dataclasses.dataclass
 class _Region:
     box: tuple[int, int, int, int]  # x, y, w, h in luma pixels, even where the chroma is subsampled
-    first: float  # time of its first step
+    first: float  # time of its first step (when it was found)
     patch: list  # the planes' crops (float32) from the frame before its first step
     ring: tuple[int, int, int, int]  # x0, y0, x1, y1: the band about the box whose light it follows
     ring_ref: np.ndarray  # that band's luma in the frame before the first step
+    start: float = 0.0  # time of the first frame masked (the clip's start when found in its first seconds)
 
 
 class OverlayFilter:
@@ -92,6 +104,9 @@ class OverlayFilter:
         self._run_n = 0
         self._stepped = None  # per sample: the _run_n at which it last changed by a step's size
         self._contrast = ABS_STEP  # codes: what a step changes (K_STEP noise sigmas, ABS_STEP at least)
+        self._holding = True  # the clip's first frames are held back (HOLD_SECONDS, HOLD_BYTES)
+        self._held_bytes = 0
+        self._t0 = None
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
@@ -185,6 +200,53 @@ class OverlayFilter:
         fps = float(getattr(getattr(self.reader, "info", None), "fps", 0) or 30.0)
         return max(1, round(STATIC_EVERY * fps))
 
+    def _line(self, boxes) -> list[tuple[int, int, int, int]]:
+        """Boxes (sample coordinates) of the rest of the text line each step box in ``boxes`` lies
+        in: the samples of its rows, either side, that stand out from the wall in the step's text
+        colour, as far as they run on with gaps under the line's height (a clock's other digits
+        and its date step later, or never within the clip; the static finder misses them where a
+        codec holds most of the frame still)."""
+        import cv2
+
+        s = self._frames[-(AFTER + 1)].astype(np.float32)  # the frame after the step
+        h, w = s.shape
+        k = int(max(5, (2 * h * TEXT_LINE) // 2 * 2 + 1))
+        thr = max(self._contrast, STATIC_CONTRAST)
+        found = []
+        cover = np.zeros((h, w), bool) if self._taken is None or self._taken.shape != (h, w) else self._taken.copy()
+        for x0, y0, x1, y1 in boxes:
+            cover[y0:y1, x0:x1] = True
+        for x0, y0, x1, y1 in boxes:
+            b0, b1 = max(y0 - k, 0), min(y1 + k, h)
+            ground = cv2.medianBlur(np.clip(s[b0:b1], 0, 255).astype(np.uint8), k).astype(np.float32)
+            band, ground = s[y0:y1], ground[y0 - b0:y1 - b0]
+            out = np.abs(band - ground) > thr
+            if int(out[:, x0:x1].sum()) < MIN_PIXELS:
+                continue
+            colour = float(np.median(band[:, x0:x1][out[:, x0:x1]]))
+            cols = (out & (np.abs(band - colour) <= STEP_FLAT)).any(axis=0)
+            gap = y1 - y0
+            lo = x0
+            while True:
+                near = np.flatnonzero(cols[max(lo - gap, 0):lo])
+                if not near.size:
+                    break
+                lo = max(lo - gap, 0) + int(near[0])
+            hi = x1
+            while True:
+                near = np.flatnonzero(cols[hi:min(hi + gap, w)])
+                if not near.size:
+                    break
+                hi = hi + int(near[-1]) + 1
+            most = int(MAX_BOX * h * w) // max(gap, 1)  # wide lines in pieces, each an overlay's box
+            for a, b in ((max(lo - PAD, 0), x0), (x1, min(hi + PAD, w))):
+                for c in range(a, b, max(most, 1)):
+                    e = min(c + most, b)
+                    if e > c and not cover[y0:y1, c:e].all():
+                        found.append((c, y0, e, y1))
+                        cover[y0:y1, c:e] = True
+        return found
+
     def _static(self) -> list[tuple[int, int, int, int]]:
         """Boxes (sample coordinates) of text that has hardly changed over STILL_RUN seconds."""
         import cv2
@@ -229,8 +291,11 @@ class OverlayFilter:
                 found.append((x0, y0, x1, y1))
         return found
 
-    def _take(self, boxes, t: float) -> None:
-        planes = self._last.planes
+    def _take(self, boxes, t: float, before, start: float) -> None:
+        """Mask ``boxes`` (found at time ``t``) from the first frame not yet handed on (time
+        ``start``), each filled with what ``before`` (the frame before its step, masked as far as
+        known) shows there."""
+        planes = before.planes
         s = self._step
         h, w = planes.y.shape
         ax = 1 << max(planes.sub_x, 0) if planes.u is not None else 1
@@ -245,9 +310,9 @@ class OverlayFilter:
             patch = [_crop(p, box, planes, i) for i, p in enumerate(_arrays(planes))]
             X0, Y0, X1, Y1 = max(X0 - RING, 0), max(Y0 - RING, 0), min(X1 + RING, w), min(Y1 + RING, h)
             ring = np.array(planes.y[Y0:Y1, X0:X1], np.float32)
-            self.regions.append(_Region(box, round(float(t), 4), patch, (X0, Y0, X1, Y1), ring))
+            self.regions.append(_Region(box, round(float(t), 4), patch, (X0, Y0, X1, Y1), ring, round(float(start), 4)))
             for check in self.checks:
-                check.mask(box, t)
+                check.mask(box, t, start)
         self._taken = np.zeros_like(self._prev, bool)
         for r in self.regions:
             x, y, bw, bh = r.box
@@ -272,19 +337,40 @@ class OverlayFilter:
         self._last = frame
         return frame
 
+    def _frame(self, i: int, fill: bool = True):
+        """Frame ``i`` (of those this filter was given) as masked so far, if it is still known:
+        waiting, or the last handed on (``fill`` False: whether it is, without masking it)."""
+        pos = i - (self._index - len(self._waiting) + 1)
+        if pos >= 0:
+            return self._fill(self._waiting[pos]) if fill else True
+        return self._last if pos == -1 else None
+
+    def _hold(self, frame) -> None:
+        """Whether the clip's first frames are still held back (see HOLD_SECONDS)."""
+        if self._t0 is None:
+            self._t0 = float(frame.time)
+        self._held_bytes += sum(int(getattr(a, "nbytes", 0)) for a in _arrays(frame.planes))
+        if float(frame.time) - self._t0 >= HOLD_SECONDS or self._held_bytes > HOLD_BYTES:
+            self._holding = False
+
     def frames(self) -> Iterator:
         for frame in self.reader.frames():
             self._index += 1
             self._observe(frame.planes)
             self._waiting.append(frame)
+            if self._holding:
+                self._hold(frame)
             j = self._index - AFTER
-            if j >= 1 and self._last is not None:
+            if j >= 1 and self._frame(j - 1, fill=False) is not None:
                 boxes = self._judge(j)
+                if boxes:
+                    boxes += self._line(boxes)
                 if self._run is not None and self._index % self._static_every() == 0:
                     boxes += self._static()
                 if boxes:
-                    self._take(boxes, self._waiting[0].time)
-            while len(self._waiting) > AFTER:
+                    found = self._waiting[j - (self._index - len(self._waiting) + 1)].time
+                    self._take(boxes, found, self._frame(j - 1), self._waiting[0].time)
+            while not self._holding and len(self._waiting) > AFTER:
                 yield self._release()
         while self._waiting:
             yield self._release()
@@ -298,13 +384,16 @@ class OverlayFilter:
 
     def masked(self) -> list[dict]:
         """The ``view.masked`` entries (docs/contract.md): the boxes, overlapping ones merged."""
-        return merged([(r.box, r.first) for r in self.regions])
+        return merged([(r.box, r.first, r.start) for r in self.regions])
 
 
 def merged(items) -> list[dict]:
-    """[(box, first)] as ``view.masked`` entries, boxes that touch joined into one."""
+    """[(box, first, start)] as ``view.masked`` entries, boxes that touch joined into one:
+    ``from`` the time it was found, ``masked_from`` the time of the first frame masked."""
     groups: list[list] = []
-    for box, first in sorted(items, key=lambda r: (r[0][1], r[0][0])):
+    for item in sorted(items, key=lambda r: (r[0][1], r[0][0])):
+        box, first = item[0], item[1]
+        start = item[2] if len(item) > 2 else first
         x, y, w, h = box
         for g in groups:
             gx, gy, gw, gh = g[0]
@@ -312,10 +401,11 @@ def merged(items) -> list[dict]:
                 nx, ny = min(x, gx), min(y, gy)
                 g[0] = (nx, ny, max(x + w, gx + gw) - nx, max(y + h, gy + gh) - ny)
                 g[1] = min(g[1], first)
+                g[2] = min(g[2], start)
                 break
         else:
-            groups.append([box, first])
-    return [{"box": [int(v) for v in b], "kind": "overlay", "from": f} for b, f in groups]
+            groups.append([box, first, start])
+    return [{"box": [int(v) for v in b], "kind": "overlay", "from": f, "masked_from": m} for b, f, m in groups]
 
 
 def _median_p90(a: np.ndarray) -> tuple[float, float]:

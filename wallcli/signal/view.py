@@ -81,6 +81,7 @@ class ViewCheck:
         self.note_spans: dict[str, list[list[float]]] = {k: [] for k in NOTES}
         self.trace: list | None = None  # a list: _objects appends what it judged on (research/view)
         self.masked: list = []  # (box, first seen): burned-in overlays masked out of the frames (signal/overlay)
+        self.masked_from: list = []  # per box: the time of the first frame masked (the clip's start when held)
         # each 'moving object' flag's time and blocks, until too many to keep: an overlay is only
         # recognised after its text has stepped a few times, and those steps were flagged first
         self._object_hits: list | None = []
@@ -91,13 +92,14 @@ class ViewCheck:
             self.gap(frame.time - gap, frame.time)
         self.update(frame.time, frame.planes)
 
-    def mask(self, box, first: float = 0.0) -> None:
+    def mask(self, box, first: float = 0.0, start: float | None = None) -> None:
         """The frames fed from now on have ``box`` (x, y, w, h, source pixels) masked: an overlay.
         Earlier 'moving object' flags whose blocks all lie in the overlays' boxes were the text's
         own steps, before it was recognised: they are taken back."""
         import cv2
 
         self.masked.append((tuple(int(v) for v in box), round(float(first), 4)))
+        self.masked_from.append(round(float(first if start is None else start), 4))
         hits = self._object_hits
         if not hits or self._bad_geometry is None:
             return
@@ -412,7 +414,7 @@ class ViewCheck:
         """What :meth:`view` and :meth:`summary` answer from, as JSON (a .npz plot's metadata
         keeps it, so answers read from the plot carry the verdict of the video's check)."""
         return {"spans": {k: [list(s) for s in v] for k, v in self.spans.items()}, "frames": self.frames,
-                "max_shift": self.max_shift, "min_usable": self.min_usable, "masked": [[list(b), f] for b, f in self.masked],
+                "max_shift": self.max_shift, "min_usable": self.min_usable, "masked": [[list(b), f, s] for (b, f), s in zip(self.masked, self.masked_from)],
                 "noise": float(np.median(self._sig_b)) if self._sig_b else None}
 
     @classmethod
@@ -426,8 +428,8 @@ class ViewCheck:
         check.max_shift = float(record.get("max_shift") or 0.0)
         check.min_usable = float(record.get("min_usable", 1.0))
         check._object_hits = None  # the spans recorded are final
-        for box, first in record.get("masked") or []:
-            check.mask(box, first)
+        for box, first, *start in record.get("masked") or []:
+            check.mask(box, first, *start[:1])
         if record.get("noise") is not None:
             check._sig_b.append(float(record["noise"]))
         return check
@@ -438,7 +440,7 @@ class ViewCheck:
         return {**self.view(), "gaps": [list(s) for s in self.spans["frame gap"]],
                 "frames": self.frames, "max_shift_px": round(self.max_shift, 2),
                 "min_usable_area": round(self.min_usable, 3),
-                "noise": None if noise is None else round(noise, 4), "masked": merged(self.masked)}
+                "noise": None if noise is None else round(noise, 4), "masked": merged([(b, f, s) for (b, f), s in zip(self.masked, self.masked_from)])}
 
 
 def _spans_text(spans: list) -> str:
