@@ -88,13 +88,13 @@ def _best(fn, repeat: int = 30) -> float:
 def micro(clip: Path) -> None:
     import numpy as np
 
+    from wallcli.camera import corrections as corr
     from wallcli.infer.classify import _predict_window
     from wallcli.infer.model import load_model
     from wallcli.infer.stream import RowStream
     from wallcli.io.video import open_video
-    from wallcli.signal import corrections as corr
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.snr import SnrAccumulator
+    from wallcli.snr.estimate import SnrAccumulator
 
     models = {t: load_model(t, None) for t in ("count", "activity")}
     with open_video(str(clip)) as reader:

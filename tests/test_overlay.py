@@ -96,9 +96,9 @@ def test_masked_box_follows_the_light_about_it():
     frozen patch that a change of light would make stand out."""
     from types import SimpleNamespace
 
+    from wallcli.camera.overlay import OverlayFilter
     from wallcli.io.planes import Planes
     from wallcli.io.video import Frame
-    from wallcli.signal.overlay import OverlayFilter
     from wallcli.sim.overlay import text_mask
 
     rng = np.random.default_rng(0)

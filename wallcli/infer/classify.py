@@ -16,9 +16,9 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from wallcli.camera import corrections as corr
 from wallcli.errors import WallcliError
 from wallcli.infer.confidence import judge
-from wallcli.signal import corrections as corr
 from wallcli.signal.window import StreamWindower, resample, run_window_starts, window_signal_db
 
 CHUNK = 64  # windows normalised and run at a time, bounding memory on long clips
@@ -150,7 +150,7 @@ def native_fps(time) -> float | None:
 
 def _corrected(model, wins: dict, offsets: dict, native, options, starts=None, shifts=None):
     """(windows, findings per window): ``wins`` {name: (n, bins, W, 3)} with the whole-frame light
-    nuisances of :mod:`wallcli.signal.corrections` divided out (all of a window's parts together),
+    nuisances of :mod:`wallcli.camera.corrections` divided out (all of a window's parts together),
     and the camera's shake regressed out where ``shifts`` (n, W, 2) were measured."""
     names = list(wins)
     if not options.any:
@@ -196,7 +196,7 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
                      stride=stride, source=source, found=found)
     view = (plot.meta or {}).get("view")
     if isinstance(view, dict):  # the verdict of the video's check, kept by stplot
-        from wallcli.signal.view import ViewCheck
+        from wallcli.view.check import ViewCheck
 
         result = with_view(result, ViewCheck.restore(view))
     return result
@@ -291,7 +291,7 @@ def judge_view(rec: dict[str, Any], view: dict) -> dict[str, Any]:
 
 
 def with_view(result: dict[str, Any], check) -> dict[str, Any]:
-    """``result`` with the verdict of the view check (:class:`wallcli.signal.view.ViewCheck`, fed
+    """``result`` with the verdict of the view check (:class:`wallcli.view.check.ViewCheck`, fed
     the same decode) on each window and on the clip."""
     for w in result.get("windows", []):
         judge_view(w, check.view(w["start"], w["end"]))
@@ -309,11 +309,11 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     decoded frame (:class:`wallcli.io.video.FrameTee`), e.g. to measure the SNR in the same decode.
     The view check rides on the same decode; its verdict is in the result (:func:`with_view`).
     """
-    from wallcli.io.video import FrameTee, open_video
+    from wallcli.camera.pipeline import CameraPipeline
+    from wallcli.camera.tnr import TemporalNoise, bound_result
     from wallcli.infer.stream import PlotThumbnail, RowStream
-    from wallcli.signal.pipeline import CameraPipeline
-    from wallcli.signal.tnr import TemporalNoise, bound_result
-    from wallcli.signal.view import ViewCheck
+    from wallcli.io.video import FrameTee, open_video
+    from wallcli.view.check import ViewCheck
 
     classifier = WindowClassifier(model, stride, corrections=corrections)
     thumb = PlotThumbnail() if keep_plot else None
@@ -387,11 +387,11 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     Rows are raw (not clip-mean-removed): ``normalize_window`` removes each window's own
     mean, so no clip mean, which a live stream does not have, is needed.
     """
-    from wallcli.io.video import FrameTee, open_video
+    from wallcli.camera.pipeline import CameraPipeline
+    from wallcli.camera.tnr import TemporalNoise, bound_result
     from wallcli.infer.stream import RowStream
-    from wallcli.signal.pipeline import CameraPipeline
-    from wallcli.signal.tnr import TemporalNoise, bound_result
-    from wallcli.signal.view import ViewCheck
+    from wallcli.io.video import FrameTee, open_video
+    from wallcli.view.check import ViewCheck
 
     # the classifier of classify_video, so that the lines are its windows (and its clip answer)
     classifier = WindowClassifier(model, stride, corrections=corrections)

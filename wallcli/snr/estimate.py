@@ -251,14 +251,14 @@ class SnrAccumulator:
         self.levels = [n for n in self.scales if lat.th // n >= 1 and lat.tw // n >= 1]
         if self.shake and SHAKE_BLOCK in self.levels:
             from wallcli.signal.blocks import LumaShift
-            from wallcli.signal.shake import ShakeSums
+            from wallcli.camera.shake import ShakeSums
 
             self._register = LumaShift()
             self._shake = ShakeSums((3, lat.nty, lat.th // SHAKE_BLOCK, lat.ntx, lat.tw // SHAKE_BLOCK))
         if self.options is not None:
             from collections import deque
 
-            from wallcli.signal import corrections as corr
+            from wallcli.camera import corrections as corr
 
             self.row_band = corr.bands(lat.nty * lat.th)
             self.col_band = corr.bands(lat.ntx * lat.tw)
@@ -486,7 +486,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
         "warnings": [*notes, *res.warnings],
         "corrections": acc.corrections,
     }
-    from wallcli.signal.snr_verdict import snr_verdict
+    from wallcli.snr.verdict import snr_verdict
 
     out["verdict"] = snr_verdict(out)  # here, not in the command: scan's snr object is this one too
     return out

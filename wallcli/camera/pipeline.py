@@ -12,9 +12,9 @@ from __future__ import annotations
 from typing import Iterator
 
 from wallcli.signal.blocks import one_opencv_thread
-from wallcli.signal.interlace import InterlaceFilter
-from wallcli.signal.overlay import OverlayFilter
-from wallcli.signal.repeats import RepeatFilter
+from wallcli.camera.interlace import InterlaceFilter
+from wallcli.camera.overlay import OverlayFilter
+from wallcli.camera.repeats import RepeatFilter
 
 
 class CameraPipeline:
