@@ -42,8 +42,10 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     from wallcli.camera.pipeline import CameraPipeline
     from wallcli.camera.tnr import TemporalNoise, bound_result
     from wallcli.errors import WallcliError
-    from wallcli.infer.classify import WindowClassifier, stream_row, with_view
+    from wallcli.infer.classify import WindowClassifier
+    from wallcli.infer.judge import with_view
     from wallcli.infer.stream import RowStream
+    from wallcli.infer.windows import stream_row
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
     from wallcli.snr.estimate import SnrAccumulator, snr_report

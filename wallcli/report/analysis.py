@@ -140,8 +140,10 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
 
     from wallcli.camera.corrections import Options
     from wallcli.camera.tnr import bound_result
-    from wallcli.infer.classify import WindowClassifier, _thumb_plot, stream_row, with_view
+    from wallcli.infer.classify import WindowClassifier
+    from wallcli.infer.judge import with_view
     from wallcli.infer.stream import PlotThumbnail, RowStream
+    from wallcli.infer.windows import stream_row
     from wallcli.io.video import open_video
 
     if str(source).lower().endswith(".npz"):
@@ -168,7 +170,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     if rows.frames < 2:
         raise WallcliError(f"{source} has {rows.frames} frame(s); a space-time plot needs at least 2 "
                            "(the temporal mean of one frame is the frame itself)")
-    plot = _thumb_plot(thumb, rows, first)
+    plot = thumb.plot(rows, first.bins, first.fps)
     plot.meta.update(frame_size=list(rows.frame_size), fps_fraction=f"{info.fps.numerator}/{info.fps.denominator}")
     notes = list(dict.fromkeys([str(w.message) for w in caught] + list(reader.warnings)))
     if tee.snr is not None:
