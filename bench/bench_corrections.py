@@ -88,13 +88,13 @@ def _best(fn, repeat: int = 30) -> float:
 def micro(clip: Path) -> None:
     import numpy as np
 
-    from wallcli.infer.classify import _predict_window
+    from wallcli.camera import corrections as corr
     from wallcli.infer.model import load_model
     from wallcli.infer.stream import RowStream
+    from wallcli.infer.windows import predict_window
     from wallcli.io.video import open_video
-    from wallcli.signal import corrections as corr
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.snr import SnrAccumulator
+    from wallcli.snr.estimate import SnrAccumulator
 
     models = {t: load_model(t, None) for t in ("count", "activity")}
     with open_video(str(clip)) as reader:
@@ -108,7 +108,7 @@ def micro(clip: Path) -> None:
     print("| CPU per window (256 samples; one every 64 frames) | off | deflicker | exposure | both | ratio, both |")
     print("|---|---|---|---|---|---|")
     for task, model in models.items():
-        ms = {name: 1e3 * _best(lambda o=o: _predict_window(model, win, ref, native=30.0, options=o))
+        ms = {name: 1e3 * _best(lambda o=o: predict_window(model, win, ref, native=30.0, options=o))
               for name, o in (("off", corr.OFF), ("deflicker", corr.Options(True, False, False)),
                               ("exposure", corr.Options(False, True, False)), ("both", corr.Options(True, True, False)))}
         print(f"| {task} | {ms['off']:.1f} ms | {ms['deflicker']:.1f} ms | {ms['exposure']:.1f} ms | {ms['both']:.1f} ms "

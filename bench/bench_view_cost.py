@@ -30,7 +30,7 @@ from clips import clip_1080p  # noqa: E402
 _RUN = """
 import sys
 if sys.argv[1] == "without":
-    from wallcli.signal import view
+    from wallcli.view import check as view
     view.ViewCheck.update = lambda self, t, planes: None
 sys.argv = ["wallcli", *sys.argv[2:]]
 from wallcli.cli.entry import main

@@ -57,7 +57,7 @@ def test_a_hunted_clip_keeps_the_clean_answer_and_lists_the_hunt(hunted, run_cli
 def test_white_balance_finds_per_colour_gains_and_leaves_a_grey_change_alone():
     """On synthetic profiles: a colour-only drift is found per colour and removed; the same drift
     on all colours alike (a light's level) is not a white balance (the grey fit's business)."""
-    from wallcli.signal.whitebalance import white_balance
+    from wallcli.camera.whitebalance import white_balance
 
     rng = np.random.default_rng(1)
     t = np.arange(256) / 30.0

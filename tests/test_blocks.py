@@ -128,8 +128,8 @@ def test_the_camera_pipeline_holds_one_opencv_thread_for_its_decode_and_gives_it
     import cv2
 
     from clips import write_clip
+    from wallcli.camera.pipeline import CameraPipeline
     from wallcli.io.video import open_video
-    from wallcli.signal.pipeline import CameraPipeline
 
     rng = np.random.default_rng(5)
     clip = write_clip(tmp_path / "wall.mp4", lambda i: 120 + rng.normal(0, 2, (72, 96, 3)), 12)

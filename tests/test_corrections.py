@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from wallcli.signal import corrections as C
+from wallcli.camera import corrections as C
 
 T, B, FPS = 256, 64, 30.0
 t = np.arange(T) / FPS

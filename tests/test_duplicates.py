@@ -83,7 +83,7 @@ def test_repeat_filter_streams_and_finds_copies_among_the_first_frames():
     and the frames that pass keep their order and times."""
     from types import SimpleNamespace
 
-    from wallcli.signal.repeats import RepeatFilter
+    from wallcli.camera.repeats import RepeatFilter
 
     rng = np.random.default_rng(0)
     copy = np.zeros(60, bool)

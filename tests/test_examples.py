@@ -94,7 +94,7 @@ def test_every_example_is_a_usable_view(clip):
     them (sharp shadows of people near the wall under a lamp) were refused as 'moving object' or
     'camera motion' before session 19."""
     from wallcli.io.video import open_video
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     vc = ViewCheck()
     with open_video(clip) as reader:

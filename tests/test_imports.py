@@ -1,6 +1,7 @@
 """The house has no circles: no two modules of wallcli import each other, directly or round a
 loop, counting imports inside functions too (sim/pathtrace.py and sim/scene.py once did: a scene
-describes, a world renders it)."""
+describes, a world renders it), and the method's folders stand on each other in one order: none
+imports a folder above it, and only the CLI knows the CLI."""
 from __future__ import annotations
 
 import ast
@@ -79,3 +80,36 @@ def test_the_scene_does_not_know_the_path_tracer():
     edges = _imports()
     assert "wallcli.sim.pathtrace" not in edges["wallcli.sim.scene"]
     assert "wallcli.sim.scene" not in edges["wallcli.sim.pathtrace"]
+
+
+# The method's folders, ground floor first: each may import only the ones named (and itself), so a
+# frame's way runs one way: decode (io) -> the camera's artefacts out (camera) -> is the view usable
+# (view) / how strong is the signal (snr) -> plots and windows (signal) above them all.
+# signal/ is the ground of the method (block sums, Roi) that camera/, view/ and snr/ stand on.
+MAY_IMPORT = {
+    "errors": set(),
+    "wording": set(),
+    "io": {"errors"},
+    "signal": {"errors", "wording"},
+    "camera": {"errors", "wording", "signal"},
+    "view": {"errors", "wording", "signal", "camera"},
+    "snr": {"errors", "wording", "signal", "camera"},
+}
+
+
+def _folder(module: str) -> str:
+    """wallcli.view.check -> 'view'; wallcli.errors -> 'errors'; the package itself -> ''."""
+    return module.split(".")[1] if "." in module else ""
+
+
+def test_the_method_s_folders_never_climb():
+    edges = _imports()
+    climbs = sorted(f"{m} -> {t}" for m, targets in edges.items() for t in targets
+                    if _folder(m) in MAY_IMPORT and _folder(t) not in MAY_IMPORT[_folder(m)] | {_folder(m), ""})
+    assert climbs == []
+
+
+def test_only_the_cli_knows_the_cli():
+    edges = _imports()
+    assert sorted(f"{m} -> {t}" for m, targets in edges.items() for t in targets
+                  if _folder(t) == "cli" and _folder(m) not in {"cli", "__main__"}) == []

@@ -85,7 +85,7 @@ def _frames(n, offset, seed=0):
 def test_fields_are_brought_to_one_instant(offset):
     from types import SimpleNamespace
 
-    from wallcli.signal.interlace import InterlaceFilter
+    from wallcli.camera.interlace import InterlaceFilter
 
     wall = 100 + 30 * np.random.default_rng(0).random((48, 64))  # _frames' wall
     f = InterlaceFilter(SimpleNamespace(frames=lambda: _frames(60, offset)))

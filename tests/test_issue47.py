@@ -363,9 +363,9 @@ def test_a_repeat_left_out_after_a_jump_hands_its_gap_on():
     the repeat filter drops it, and the next frame must still restart the grid."""
     from types import SimpleNamespace
 
+    from wallcli.camera.repeats import RepeatFilter
     from wallcli.io.planes import Planes
     from wallcli.io.video import Frame
-    from wallcli.signal.repeats import RepeatFilter
 
     rng = np.random.default_rng(0)
     ys = [rng.integers(0, 255, (16, 16), dtype=np.uint8) for _ in range(40)]
@@ -448,11 +448,11 @@ def _stplot_peak(clip: Path, out: Path) -> tuple[int, int]:
     """(tracemalloc peak of stplot's work on ``clip`` as the command does it, the plot's bytes)."""
     import tracemalloc
 
+    from wallcli.camera.pipeline import CameraPipeline
     from wallcli.io.arrays import save_npz
     from wallcli.io.video import FrameTee, open_video
-    from wallcli.signal.pipeline import CameraPipeline
     from wallcli.signal.stplot import channel_std, compute_stplot, to_arrays
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     tracemalloc.start()
     try:

@@ -96,9 +96,9 @@ def test_masked_box_follows_the_light_about_it():
     frozen patch that a change of light would make stand out."""
     from types import SimpleNamespace
 
+    from wallcli.camera.overlay import OverlayFilter
     from wallcli.io.planes import Planes
     from wallcli.io.video import Frame
-    from wallcli.signal.overlay import OverlayFilter
     from wallcli.sim.overlay import text_mask
 
     rng = np.random.default_rng(0)
@@ -177,7 +177,7 @@ def _gray_clock(n, fps=30, seed=1):
 def test_a_clock_found_in_the_first_seconds_is_masked_from_the_clips_start():
     """The seconds digit is recognised at its first step (1 s) or later; the frames before are
     held back (decoded once), so the step at 1 s and every frame before it are masked too."""
-    from wallcli.signal.overlay import OverlayFilter
+    from wallcli.camera.overlay import OverlayFilter
 
     f = OverlayFilter(_gray_clock(150))
     out = list(f.frames())
@@ -195,7 +195,7 @@ def test_a_clock_found_in_the_first_seconds_is_masked_from_the_clips_start():
 
 def test_the_start_held_back_is_bounded():
     """At most HOLD_SECONDS of frames wait, whatever the clip's length: memory stays flat."""
-    from wallcli.signal import overlay
+    from wallcli.camera import overlay
 
     f = overlay.OverlayFilter(_gray_clock(600))
     most = 0
@@ -214,7 +214,7 @@ def test_a_steps_whole_text_line_is_masked_from_the_start():
 
     from wallcli.io.planes import Planes
     from wallcli.io.video import Frame
-    from wallcli.signal.overlay import OverlayFilter
+    from wallcli.camera.overlay import OverlayFilter
     from wallcli.sim.overlay import EPOCH, text_mask
 
     rng = np.random.default_rng(2)

@@ -57,7 +57,7 @@ def _profiles(frames, register=True):
 
 
 def _correct(rows, shifts, shake=True):
-    from wallcli.signal import corrections as C
+    from wallcli.camera import corrections as C
 
     win = rows[-256:].transpose(1, 0, 2)[None].astype(np.float32)  # (1, bins, T, 3)
     out, found = C.correct_windows([win], [np.zeros((1, 64, 3), np.float32)], 30.0,
@@ -106,7 +106,7 @@ def test_a_still_camera_and_no_shake_option_change_nothing():
 
 
 def test_unshake_needs_shifts_that_explain_the_profiles():
-    from wallcli.signal.shake import unshake
+    from wallcli.camera.shake import unshake
 
     rng = np.random.default_rng(4)
     # profiles that do not move with the camera (a plain wall): a slow light and the sensor's noise
@@ -136,9 +136,9 @@ def test_count_lists_shake_and_no_shake_turns_it_off(tmp_path, run_cli):
 
 
 def _snr(frames, shake: bool):
+    from wallcli.camera.corrections import Options
     from wallcli.io.video import Planes
-    from wallcli.signal.corrections import Options
-    from wallcli.signal.snr import SnrAccumulator
+    from wallcli.snr.estimate import SnrAccumulator
 
     acc = SnrAccumulator((0, 0, frames[0].shape[1], frames[0].shape[0]),
                          corrections=Options(deflicker=False, exposure=False, shake=shake), fps=30.0)
@@ -163,7 +163,7 @@ def test_the_snr_of_a_shaking_clip_is_the_still_clips():
 
 def test_shake_sums_give_the_regressed_series_sums_exactly():
     """The SNR path's sums after the fact equal those of the series with the fit removed."""
-    from wallcli.signal.shake import ShakeSums, regressors
+    from wallcli.camera.shake import ShakeSums, regressors
 
     rng = np.random.default_rng(7)
     t, p = 120, 6

@@ -12,7 +12,7 @@ import pytest
 from clips import write_clip
 
 from wallcli.io.video import open_video
-from wallcli.signal.snr import SnrAccumulator
+from wallcli.snr.estimate import SnrAccumulator
 
 T = 300
 PERIOD = 40  # frames; the seed's estimator needs a slow signal (>= 30 frames)
@@ -325,7 +325,7 @@ def test_lattice_tiles_stay_on_whole_chroma_samples():
     # ROI height 130 (2 mod 4) centred a 128-row lattice at row 1: an odd luma row paired with
     # the wrong 4:2:0 chroma row. Every sampled pixel must get the chroma sample that covers it.
     from wallcli.io.video import Planes
-    from wallcli.signal.snr import Lattice
+    from wallcli.snr.estimate import Lattice
 
     lat = Lattice.plan((0, 0, 256, 130), 32768)
     assert not lat.exact and lat.oy % 2 == 0 and lat.ox % 2 == 0

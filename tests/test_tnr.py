@@ -77,7 +77,7 @@ def _frames(ys):
 
 @pytest.mark.parametrize("a", [0.0, 0.6])
 def test_temporal_noise_reads_the_blend(a):
-    from wallcli.signal.tnr import TemporalNoise
+    from wallcli.camera.tnr import TemporalNoise
 
     rng = np.random.default_rng(2)
     wall = 100 + 10 * rng.random((72, 96))
@@ -93,7 +93,7 @@ def test_temporal_noise_reads_the_blend(a):
 
 def test_a_codec_that_holds_blocks_is_not_judged():
     """Noise held in whole blocks from one frame to the next is the codec's, not a camera's blend."""
-    from wallcli.signal.tnr import TemporalNoise
+    from wallcli.camera.tnr import TemporalNoise
 
     rng = np.random.default_rng(3)
     tap = TemporalNoise()

@@ -30,7 +30,7 @@ def _encode(path, frames):
 
 def _check(path) -> dict:
     from wallcli.io.video import open_video
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     vc = ViewCheck()
     with open_video(path) as reader:
@@ -100,7 +100,7 @@ def test_clipped_and_dark_frames_leave_too_little_usable_area(tmp_path):
 
 
 def test_memory_does_not_grow_with_the_number_of_issues():
-    from wallcli.signal.view import MAX_SPANS, ViewCheck
+    from wallcli.view.check import MAX_SPANS, ViewCheck
 
     vc = ViewCheck()
     vc.frames = 1
@@ -113,7 +113,7 @@ def test_memory_does_not_grow_with_the_number_of_issues():
 
 def test_a_span_that_rounds_to_one_instant_reads_as_one_time():
     """'camera motion at 0.6-0.6 s' read as a range of nothing: such a span is 'at 0.6 s'."""
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     vc = ViewCheck()
     vc.frames = 1
@@ -340,7 +340,7 @@ def test_a_sharp_shadow_is_a_note_and_an_object_in_its_place_is_refused(tmp_path
 def test_a_camera_that_moves_over_a_wall_with_nothing_to_register_on_is_not_verifiable():
     """Issue 36: where the wall has no texture to register on, a shift the correlation finds is
     no proof: 'motion not verifiable', which does not make the view unusable (answers stand)."""
-    from wallcli.signal.view import NOT_REFUSED, ViewCheck
+    from wallcli.view.check import NOT_REFUSED, ViewCheck
 
     vc = ViewCheck()
     vc.frames = 1

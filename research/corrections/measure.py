@@ -33,8 +33,8 @@ ACTIVITIES = ("walking", "crouching", "waving", "jumping")
 
 def _analyse(path: Path, models, on: bool) -> dict:
     from wallcli.batch.analyse import analyse
+    from wallcli.camera.corrections import OFF, Options
     from wallcli.evaluate.clip import GREEN, plot_block
-    from wallcli.signal.corrections import OFF, Options
 
     out = analyse(str(path), ("count", "activity", "snr"), models, corrections=Options() if on else OFF)
     snr = out["snr"]

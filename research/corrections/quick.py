@@ -50,9 +50,9 @@ def _clip(cache: Path, seed: int, kind: str) -> Path:
 
 def run(out: Path, cache: Path, seeds, rec: bool) -> None:
     from wallcli.batch.analyse import analyse
+    from wallcli.camera import corrections as C
     from wallcli.evaluate.clip import GREEN, plot_block
     from wallcli.infer.model import load_model
-    from wallcli.signal import corrections as C
 
     calls = []
     fit = C.fit
@@ -111,7 +111,7 @@ def table(out: Path) -> list[str]:
 
 
 def offline(out: Path, kind: str) -> list[str]:
-    from wallcli.signal import corrections as C
+    from wallcli.camera import corrections as C
 
     def rel(x):
         return x / x.mean(0) - 1

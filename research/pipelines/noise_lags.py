@@ -50,7 +50,7 @@ GRID = np.round(np.arange(0.0, 0.96, 0.01), 2)
 
 
 def _tiles(h: int, w: int) -> list[tuple[int, int]]:
-    from wallcli.signal.tnr import _tiles as tiles
+    from wallcli.camera.tnr import _tiles as tiles
 
     return tiles(h, w, TILE, MAX_TILES)
 

@@ -1,5 +1,5 @@
 """Issue 45 part 2 (session 23): can a blend be read on the noise alone on the transfer set's lossy
-clips? Per clip, on the tiles of wallcli.signal.tnr (differences of luma pixels two columns apart),
+clips? Per clip, on the tiles of wallcli.camera.tnr (differences of luma pixels two columns apart),
 each frame's tile regressed on the tile's mean texture and a constant (the light the whole tile
 shares, scaled texture included) and then: lag1 = median over tiles of d_2 / d_1 - 1; R = the
 variance of second differences at stride 2 over stride 1 (a linear trend, what a person's slow
@@ -11,7 +11,7 @@ unchanged. Not shipped: README_tnr_awb.md says why (neither separates on lossy s
 import sys, json
 import numpy as np
 from wallcli.io.video import open_video
-from wallcli.signal.tnr import _tiles, TILE
+from wallcli.camera.tnr import _tiles, TILE
 
 def stats(path, max_frames=400):
     with open_video(path) as r:

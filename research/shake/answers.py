@@ -33,9 +33,9 @@ def clip(cache: Path, seed: int, rms: float, crf: int) -> Path:
 
 
 def run(a) -> None:
+    from wallcli.camera.corrections import Options
     from wallcli.infer.classify import classify_video
     from wallcli.infer.model import load_model
-    from wallcli.signal.corrections import Options
 
     a.cache.mkdir(parents=True, exist_ok=True)
     models = {k: load_model(k) for k in ("count", "activity")}

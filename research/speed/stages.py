@@ -28,7 +28,8 @@ def wrap(owner, name: str, label: str) -> None:
 
 
 def main() -> None:
-    from wallcli.signal import interlace, overlay, repeats, tnr, view, blocks
+    from wallcli.camera import interlace, overlay, repeats, tnr
+    from wallcli.view import check as view
     from wallcli.infer import classify
     from wallcli.io import video
 

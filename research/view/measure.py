@@ -36,8 +36,8 @@ def scene_frames(seed: int, domain: str, seconds: float, size=(320, 240)):
 
 def check(frames, n, path: Path, fps=30.0) -> dict:
     from wallcli.io.video import open_video
-    from wallcli.signal.view import ViewCheck
     from wallcli.sim.views import encode
+    from wallcli.view.check import ViewCheck
 
     encode(frames, path, fps=fps)
     vc = ViewCheck()

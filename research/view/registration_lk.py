@@ -54,7 +54,7 @@ def lucas_kanade(x: np.ndarray, ref: np.ndarray, where: np.ndarray, iters: int =
     (relative textures, NaN unknown) over ``where``; None where too little is known. The standard
     error counts a pixel as a quarter, as _texture_match does: the band's pixels are correlated
     over more than that, so it is too small (see the README)."""
-    from wallcli.signal.view_motion import _warp_texture
+    from wallcli.view.motion import _warp_texture
 
     sx = sy = 0.0
     z0 = 0.0
@@ -101,7 +101,7 @@ def lucas_kanade(x: np.ndarray, ref: np.ndarray, where: np.ndarray, iters: int =
 
 
 def _hooked_match(x, ref, where):
-    import wallcli.signal.view_motion as vm
+    import wallcli.view.motion as vm
 
     m0 = vm._texture_match(x, ref, where)
     vc = STATE["vc"]
@@ -119,7 +119,7 @@ def _hooked_match(x, ref, where):
 
 
 def _one(path: str) -> dict:
-    import wallcli.signal.view as v
+    import wallcli.view.check as v
     from wallcli.io.video import open_video
 
     v._texture_match = _hooked_match

@@ -100,7 +100,7 @@ def make(a) -> None:
 
 def check_file(path: Path) -> dict:
     from wallcli.io.video import open_video
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     vc = ViewCheck()
     with open_video(path) as reader:

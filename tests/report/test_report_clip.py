@@ -344,7 +344,7 @@ def test_report_shows_the_views_notes(tmp_path, run_cli, monkeypatch):
     assert [li.text() for li in cell.find_all("li")] == view["notes"]
 
     # a note is text, never markup (autoescape)
-    from wallcli.signal import view_limits
+    from wallcli.view import limits as view_limits
 
     monkeypatch.setitem(view_limits.NOTES, "sharp light", "<b onclick=x>sharp</b> & light")
     page_path = tmp_path / "escaped.html"

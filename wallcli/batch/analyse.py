@@ -32,22 +32,24 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     """``{"frames", "duration", "fps", "warnings", "view", <task>: <its --json object>, ...}`` for ``source``.
 
     ``models``: a loaded :class:`~wallcli.infer.model.Model` per classification task asked for.
-    ``corrections``: :class:`~wallcli.signal.corrections.Options` (default: all on); what they
+    ``corrections``: :class:`~wallcli.camera.corrections.Options` (default: all on); what they
     found is in each task's object and, for the video, under ``"corrections"`` (the first task's).
     ``on_frame`` is called after every decoded frame (a watchdog's heartbeat; it may raise to
     abandon the video). Raises WallcliError when the video cannot be read or is too short for a
     task: a video either has every answer asked for or none.
     """
+    from wallcli.camera.corrections import Options
+    from wallcli.camera.pipeline import CameraPipeline
+    from wallcli.camera.tnr import TemporalNoise, bound_result
     from wallcli.errors import WallcliError
-    from wallcli.infer.classify import WindowClassifier, stream_row, with_view
+    from wallcli.infer.classify import WindowClassifier
+    from wallcli.infer.judge import with_view
     from wallcli.infer.stream import RowStream
+    from wallcli.infer.windows import stream_row
     from wallcli.io.video import open_video
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.corrections import Options
-    from wallcli.signal.pipeline import CameraPipeline
-    from wallcli.signal.snr import SnrAccumulator, snr_report
-    from wallcli.signal.tnr import TemporalNoise, bound_result
-    from wallcli.signal.view import ViewCheck
+    from wallcli.snr.estimate import SnrAccumulator, snr_report
+    from wallcli.view.check import ViewCheck
 
     classify = [t for t in CLASSIFY if t in tasks]
     used = [models[t] for t in classify]

@@ -25,7 +25,7 @@ class ScanConfig:
     timeout: float = 300.0  # seconds without a decoded frame before a video is given up; 0 = never
     decoder_threads: int = 1  # one core per worker: FFmpeg's own threads would only compete
     onnx_threads: int = 1
-    deflicker: bool = True  # the corrections (wallcli.signal.corrections) run on every video
+    deflicker: bool = True  # the corrections (wallcli.camera.corrections) run on every video
     exposure: bool = True
     shake: bool = True
     # what the client runs (identity()); a worker that differs answers with an error line
@@ -156,7 +156,7 @@ def scan_video(source: str, config: ScanConfig) -> dict[str, Any]:
         def job(beat):
             if not is_url(source) and os.path.isfile(source):
                 line["size"], line["sha256"] = _hash(source, beat)
-            from wallcli.signal.corrections import Options
+            from wallcli.camera.corrections import Options
 
             return analyse(source, config.tasks, models, decoder_threads=config.decoder_threads, on_frame=beat,
                            corrections=Options(config.deflicker, config.exposure, config.shake))

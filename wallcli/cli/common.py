@@ -195,7 +195,7 @@ def shake_option():
 
 
 def corrections_of(no_deflicker: bool, no_exposure: bool, no_shake: bool = False):
-    """The corrections to run (wallcli.signal.corrections.Options) from the --no-* options."""
-    from wallcli.signal.corrections import Options
+    """The corrections to run (wallcli.camera.corrections.Options) from the --no-* options."""
+    from wallcli.camera.corrections import Options
 
     return Options(deflicker=not no_deflicker, exposure=not no_exposure, shake=not no_shake)

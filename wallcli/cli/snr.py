@@ -131,16 +131,16 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
              corrections=None) -> None:
     import warnings
 
+    from wallcli.camera.pipeline import CameraPipeline
     from wallcli.cli.common import parse_roi
     from wallcli.cli.output import emit_json, print_lines, print_table, progress, warn, wrote
     from wallcli.errors import WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
     from wallcli.signal.blocks import check_roi
-    from wallcli.signal.pipeline import CameraPipeline
-    from wallcli.signal.snr import SnrAccumulator, snr_db, snr_report
-    from wallcli.signal.snr_map import GridAccumulator
-    from wallcli.signal.view import ViewCheck
+    from wallcli.snr.estimate import SnrAccumulator, snr_db, snr_report
+    from wallcli.snr.map import GridAccumulator
+    from wallcli.view.check import ViewCheck
     from wallcli.wording import format_db
 
     auto = roi is not None and roi.strip().lower() == "auto"
@@ -283,7 +283,7 @@ def _parse_sweep(text: str) -> tuple[str, list[float]]:
 def _one(p: dict, approx: bool) -> dict:
     import math
 
-    from wallcli.signal.snr_predict import predict
+    from wallcli.snr.predict import predict
 
     radius = math.sqrt(p["area"] / math.pi) if p["area"] is not None else p["radius"]
     contrast = p["contrast"] if p["contrast"] is not None else p["person_radiance"] - p["background_radiance"]

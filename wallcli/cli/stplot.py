@@ -63,10 +63,10 @@ def stplot(
     from wallcli.io.writer import check_outputs, committed_together
     from wallcli.signal.stplot import compute_stplot
 
+    from wallcli.camera.pipeline import CameraPipeline
     from wallcli.io.ahead import Ahead
     from wallcli.io.video import FrameTee
-    from wallcli.signal.pipeline import CameraPipeline
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     check_outputs([output, png], force=force, inputs=[input])
     # the view check and the camera's shifts ride on the same decode: the .npz keeps both, so that
@@ -106,7 +106,7 @@ def narrow_roi(roi, bins: int) -> str | None:
 
 
 def check_summary(meta: dict) -> dict | None:
-    from wallcli.signal.view import ViewCheck
+    from wallcli.view.check import ViewCheck
 
     return ViewCheck.restore(meta["view"]).summary() if isinstance(meta.get("view"), dict) else None
 

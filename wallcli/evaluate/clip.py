@@ -40,9 +40,9 @@ def plot_block(roi, bins: int, blocks) -> int:
 def measure_clip(model, path: str | Path, *, stride: int, roi=None, threads: int = 0, corrections=None) -> dict[str, Any]:
     """{'result': the classifier's clip-level result (without its windows), 'snr_db', 'snr_block',
     'warnings'}. Raises WallcliError for a clip that cannot be analysed (missing, corrupt, too short)."""
+    from wallcli.camera.corrections import Options
     from wallcli.infer.classify import classify_plot, classify_video, load_plot
-    from wallcli.signal.corrections import Options
-    from wallcli.signal.snr import FrameSnr
+    from wallcli.snr.estimate import FrameSnr
 
     corrections = corrections if corrections is not None else Options()
 

@@ -91,7 +91,7 @@ class Model:
     def info(self) -> dict[str, str]:
         return {"name": self.card["name"], "version": self.card["version"], "sha256": self.card["sha256"]}
 
-    # -- the classifier interface of infer/classify.py (shared with infer/twostage.TwoStageCount)
+    # -- the classifier interface the stages read (infer/windows, judge, result; shared with infer/twostage.TwoStageCount)
     single = True  # one net: its raw output is its answer
 
     def classify(self, wins: dict[str, np.ndarray], offsets: dict[str, np.ndarray]) -> np.ndarray:

@@ -114,3 +114,17 @@ class PlotThumbnail:
             counts[-1] = rest
         m = counts.size
         return self._sum[:m] / counts.reshape(-1, *([1] * (self._sum.ndim - 1))), self._t[:m] / counts
+
+    def plot(self, rows: RowStream, bins: int, fps: float):
+        """The thumbnail as a :class:`~wallcli.signal.stplot.StPlot` of ``rows``' stream (for the
+        figures), the clip mean removed as compute_stplot removes it."""
+        from wallcli.signal.stplot import StPlot
+
+        cols, t = self.columns()
+        mean = self.mean()
+        x = (cols - mean).transpose(1, 0, 2).astype(np.float32)  # clip mean removed, as compute_stplot
+        raw_mean = (mean + rows.ref).astype(np.float32)
+        meta = {"source": str(rows.reader.info.source), "roi": list(rows.roi), "bins": bins, "fps": float(fps),
+                "downsample": self.factor}
+        return StPlot(np.ascontiguousarray(x[:bins]), np.ascontiguousarray(x[bins:]), t, raw_mean[:bins],
+                      raw_mean[bins:], meta)

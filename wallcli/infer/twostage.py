@@ -58,7 +58,7 @@ def combine(pc: np.ndarray, pa: np.ndarray, two_odds: float = 1.0) -> np.ndarray
 
 class TwoStageCount:
     """The count task's classifier: quacks like :class:`wallcli.infer.model.Model` for
-    :mod:`wallcli.infer.classify` (task, classes, inputs, window, fps, card), but its raw output
+    the stages of :mod:`wallcli.infer.classify` (task, classes, inputs, window, fps, card), but its raw output
     per window is both nets' probabilities side by side (3 + 5 columns); :meth:`combine` turns
     them into the count answer and :meth:`stages` says what each stage found."""
 

@@ -1,8 +1,6 @@
-"""Matplotlib set-up shared by every figure: Agg backend, atomic PNG writes, robust scaling."""
+"""Matplotlib set-up shared by every figure: Agg backend, atomic PNG writes."""
 
 from __future__ import annotations
-
-import numpy as np
 
 
 def new_figure(*args, **kwargs):
@@ -43,13 +41,3 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 120) -> None:
             fig.savefig(tmp, dpi=dpi, format="png", bbox_inches="tight")
     finally:
         plt.close(fig)
-
-
-def robust_sigma(x: np.ndarray) -> float:
-    """1.4826 x median absolute deviation: the spread of the bulk, blind to a few outliers."""
-    x = np.asarray(x, np.float64).ravel()
-    x = x[np.isfinite(x)]
-    if x.size == 0:
-        return 0.0
-    s = 1.4826 * float(np.median(np.abs(x - np.median(x))))
-    return s if s > 0 else float(np.std(x))

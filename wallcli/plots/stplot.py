@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.plots.figure import new_figure, robust_sigma, save_figure
+from wallcli.plots.figure import new_figure, save_figure
+from wallcli.signal.amplify import robust_sigma
 
 LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)
 

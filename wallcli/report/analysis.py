@@ -34,15 +34,15 @@ class ClipAnalysis:
     identity: dict[str, Any]  # the file and the stream, as decoded
     roi: tuple[int, int, int, int]  # of the space-time plots, in source pixels
     plot: Any  # wallcli.signal.stplot.StPlot
-    snr: Any  # wallcli.signal.snr.SnrResult
-    grid: Any  # wallcli.signal.snr_map.GridAccumulator
+    snr: Any  # wallcli.snr.estimate.SnrResult
+    grid: Any  # wallcli.snr.map.GridAccumulator
     frame: np.ndarray  # the first decoded frame, RGB float32 0-255
     models: dict[str, Any]  # task -> wallcli.infer.model.Model
     results: dict[str, dict] = field(default_factory=dict)  # task -> docs/contract.md result
     failures: dict[str, str] = field(default_factory=dict)  # task -> why it has no verdict
     warnings: list[str] = field(default_factory=list)
     view: dict[str, Any] = field(default_factory=dict)  # the view check's verdict on the clip
-    options: Any = None  # the corrections asked for (wallcli.signal.corrections.Options)
+    options: Any = None  # the corrections asked for (wallcli.camera.corrections.Options)
     snr_corrections: list = field(default_factory=list)  # what the SNR estimator's corrections found
 
 
@@ -57,12 +57,12 @@ class _Tee:
         self._reader, self._requested, self._corrections = reader, roi, corrections
         self.info = reader.info
         self.snr = self.grid = self.first = None
-        from wallcli.signal.tnr import TemporalNoise
-        from wallcli.signal.view import ViewCheck
+        from wallcli.camera.tnr import TemporalNoise
+        from wallcli.view.check import ViewCheck
 
         self.view = ViewCheck(roi)
-        self.blend = TemporalNoise()  # a camera's temporal noise reduction (signal/tnr.py)
-        from wallcli.signal.pipeline import CameraPipeline
+        self.blend = TemporalNoise()  # a camera's temporal noise reduction (camera/tnr.py)
+        from wallcli.camera.pipeline import CameraPipeline
 
         # repeats, burned-in overlays and interlaced fields taken out as for count and activity
         self.pipeline = CameraPipeline(reader, self.view)
@@ -73,8 +73,8 @@ class _Tee:
 
     def frames(self):
         from wallcli.signal.blocks import check_roi
-        from wallcli.signal.snr import DEFAULT_MAX_PIXELS, SnrAccumulator
-        from wallcli.signal.snr_map import GridAccumulator
+        from wallcli.snr.estimate import DEFAULT_MAX_PIXELS, SnrAccumulator
+        from wallcli.snr.map import GridAccumulator
 
         self.last = 0.0
         for frame in self.pipeline.frames():
@@ -138,11 +138,13 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     """Decode ``source`` once and measure, plot and classify it (see the module's docstring)."""
     import warnings
 
-    from wallcli.infer.classify import WindowClassifier, _thumb_plot, stream_row, with_view
-    from wallcli.signal.tnr import bound_result
+    from wallcli.camera.corrections import Options
+    from wallcli.camera.tnr import bound_result
+    from wallcli.infer.classify import WindowClassifier
+    from wallcli.infer.judge import with_view
     from wallcli.infer.stream import PlotThumbnail, RowStream
+    from wallcli.infer.windows import stream_row
     from wallcli.io.video import open_video
-    from wallcli.signal.corrections import Options
 
     if str(source).lower().endswith(".npz"):
         raise WallcliError(f"{source} is a space-time plot; a report needs the video itself (its frame, SNR and identity)")
@@ -168,7 +170,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     if rows.frames < 2:
         raise WallcliError(f"{source} has {rows.frames} frame(s); a space-time plot needs at least 2 "
                            "(the temporal mean of one frame is the frame itself)")
-    plot = _thumb_plot(thumb, rows, first)
+    plot = thumb.plot(rows, first.bins, first.fps)
     plot.meta.update(frame_size=list(rows.frame_size), fps_fraction=f"{info.fps.numerator}/{info.fps.denominator}")
     notes = list(dict.fromkeys([str(w.message) for w in caught] + list(reader.warnings)))
     if tee.snr is not None:
@@ -197,7 +199,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         "wallcli_version": __version__,
         "generated": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
-    from wallcli.signal.corrections import Options
+    from wallcli.camera.corrections import Options
 
     out = ClipAnalysis(str(source), identity, tuple(rows.roi), plot, snr, tee.grid, tee.first, models,
                        warnings=notes, view=tee.view.summary(),

@@ -37,7 +37,6 @@ from typing import Any
 
 import numpy as np
 
-from wallcli.plots.figure import robust_sigma
 from wallcli.signal.mean import RunningMean
 
 MEAN_MODES = ("ema", "window")
@@ -65,6 +64,16 @@ def quantisation_sigma(block_pixels: float, depth: int = 8) -> float:
     """Noise of a block mean of ``block_pixels`` uniformly quantised samples, in 8-bit code values."""
     step = 1.0 / float(1 << max(0, depth - 8))
     return step / math.sqrt(12.0) / math.sqrt(max(1.0, float(block_pixels)))
+
+
+def robust_sigma(x: np.ndarray) -> float:
+    """1.4826 x median absolute deviation: the spread of the bulk, blind to a few outliers."""
+    x = np.asarray(x, np.float64).ravel()
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return 0.0
+    s = 1.4826 * float(np.median(np.abs(x - np.median(x))))
+    return s if s > 0 else float(np.std(x))
 
 
 class _ExpandingEma:
@@ -216,7 +225,7 @@ def smoothing_noise_share(frame_seconds: float, smooth_seconds: float) -> float:
 
 def measured_snr_db(times: np.ndarray, signals: np.ndarray, smooth_seconds: float) -> float:
     """Signal-to-noise of the displayed blocks (dB) if ``signals`` were smoothed with
-    ``smooth_seconds``, as the SNR estimator measures it (wallcli.signal.snr): the noise power is
+    ``smooth_seconds``, as the SNR estimator measures it (wallcli.snr.estimate): the noise power is
     half the mean square frame-to-frame difference of the unsmoothed, mean-removed block signals,
     scaled by the share the low-pass keeps; the signal power is the smoothed signals' mean square
     less that noise. ``signals``: (frames, rows, cols, 3), the first frame (signal 0) left out."""

@@ -204,7 +204,7 @@ def one_opencv_thread():
     ms with other work on the cores); `wallcli count` 15 % and `stplot` 22 % less wall time
     (bench/RESULTS.md, session 10). Restored on leaving, so a program using wallcli as a library
     keeps its own OpenCV threading. A toggle is 0.2 us alone but 0.3-0.7 ms once the pool has
-    worked (it is rebuilt), so :class:`wallcli.signal.pipeline.CameraPipeline` holds one thread
+    worked (it is rebuilt), so :class:`wallcli.camera.pipeline.CameraPipeline` holds one thread
     for the whole decode and the per-frame calls inside find it set."""
     import cv2
 

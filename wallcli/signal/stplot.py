@@ -133,7 +133,7 @@ def compute_stplot(
     """Stream ``reader`` (a :class:`wallcli.io.video.VideoReader`) once into space-time plots.
 
     ``register``: also measure each frame's camera shift (:attr:`StPlot.shift`), for the shake
-    correction of answers read from the plot. ``view``: the :class:`wallcli.signal.view.ViewCheck`
+    correction of answers read from the plot. ``view``: the :class:`wallcli.view.check.ViewCheck`
     fed the same frames (e.g. through a FrameTee); its record goes into the metadata ("view")."""
     from wallcli.errors import WallcliError
 

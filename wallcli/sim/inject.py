@@ -1,6 +1,6 @@
 """Whole-frame light nuisances injected into an existing clip, with the truth known.
 
-For testing the corrections (``wallcli.signal.corrections``): the same clip with and without a
+For testing the corrections (``wallcli.camera.corrections``): the same clip with and without a
 nuisance, frame for frame and with the same camera noise, so that what changes in an analysis
 is the nuisance and its removal alone (``wallcli simulate --flicker/--ae-steps/--drift`` makes a
 new noise realisation with each option). Gains multiply the RGB code values.

@@ -115,8 +115,8 @@ def _clip_key(path: Path) -> str:
 
 def harvest_clip(path: Path) -> dict[str, np.ndarray]:
     """Every window of ``path`` at HARVEST_STRIDE, as inference cuts and corrects it."""
+    from wallcli.camera.corrections import Options
     from wallcli.infer.classify import classify_video
-    from wallcli.signal.corrections import Options
 
     cap = _Capture()
     result, _ = classify_video(cap, str(path), stride=HARVEST_STRIDE, corrections=Options())

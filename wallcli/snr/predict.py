@@ -1,11 +1,11 @@
 """The SNR a wall should show, predicted from the physics (Sharma et al. 2021, supplementary §3.1)
-and a camera model: ``snr --predict`` (the measurement is :mod:`wallcli.signal.snr`)."""
+and a camera model: ``snr --predict`` (the measurement is :mod:`wallcli.snr.estimate`)."""
 from __future__ import annotations
 
 
 
 from wallcli.errors import WallcliError
-from wallcli.signal.snr import snr_db
+from wallcli.snr.estimate import snr_db
 
 
 def coverage(radius: float, distance: float, *, approx: bool = False) -> float:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.signal.view_limits import K_SHIFT, REGISTRABLE, SHIFT_Z
+from wallcli.view.limits import K_SHIFT, REGISTRABLE, SHIFT_Z
 
 
 def _in_band(hp: np.ndarray, small: np.ndarray, fine: np.ndarray, rel: np.ndarray) -> np.ndarray:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.signal.view_limits import BLOCKS
+from wallcli.view.limits import BLOCKS
 
 
 def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:

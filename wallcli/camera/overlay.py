@@ -84,7 +84,7 @@ class _Region:
 
 class OverlayFilter:
     """A reader whose :meth:`frames` hands on frames with burned-in overlays masked; everything
-    else is the reader's. ``check`` (a :class:`wallcli.signal.view.ViewCheck`) is told each box."""
+    else is the reader's. ``check`` (a :class:`wallcli.view.check.ViewCheck`) is told each box."""
 
     def __init__(self, reader, check=None) -> None:
         self.reader = reader

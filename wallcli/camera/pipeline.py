@@ -1,8 +1,8 @@
 """The decode as every analysis reads it: a camera pipeline's artefacts taken out, in one pass.
 
-Repeated frames (a DVR's padding) are left out (:mod:`wallcli.signal.repeats`), burned-in
-overlays masked (:mod:`wallcli.signal.overlay`) and an interlaced clip's fields brought to one
-instant (:mod:`wallcli.signal.interlace`), in that order: a copy is no step of a clock, and a
+Repeated frames (a DVR's padding) are left out (:mod:`wallcli.camera.repeats`), burned-in
+overlays masked (:mod:`wallcli.camera.overlay`) and an interlaced clip's fields brought to one
+instant (:mod:`wallcli.camera.interlace`), in that order: a copy is no step of a clock, and a
 recorder's text, which does not follow the wall's light, would read as fields at two instants
 (its fill follows the light as the wall does). Each keeps a few frames at most; memory stays flat.
 """
@@ -12,15 +12,15 @@ from __future__ import annotations
 from typing import Iterator
 
 from wallcli.signal.blocks import one_opencv_thread
-from wallcli.signal.interlace import InterlaceFilter
-from wallcli.signal.overlay import OverlayFilter
-from wallcli.signal.repeats import RepeatFilter
+from wallcli.camera.interlace import InterlaceFilter
+from wallcli.camera.overlay import OverlayFilter
+from wallcli.camera.repeats import RepeatFilter
 
 
 class CameraPipeline:
     """A reader whose :meth:`frames` are the cleaned frames; everything else is the reader's.
 
-    ``check`` (a :class:`wallcli.signal.view.ViewCheck`, or several) is told the overlay boxes
+    ``check`` (a :class:`wallcli.view.check.ViewCheck`, or several) is told the overlay boxes
     masked, for the ``view`` it reports and the ROI it avoids. ``decoded`` counts the file's frames."""
 
     def __init__(self, reader, check=None) -> None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.signal.view_image import _block_side, _crop, _pixels, _rms_known, _shrink, _whole_blocks
-from wallcli.signal.view_limits import (
+from wallcli.view.image import _block_side, _crop, _pixels, _rms_known, _shrink, _whole_blocks
+from wallcli.view.limits import (
     COLOUR, COLOUR_BLOCKS, COLOUR_LEVEL, DARK, EDGE_GRAD, FLAT, FLAT_SHARE, K_OUTLIER, K_TEX, KEPT, MIN_KNOWN,
     MIN_MOVER_BLOCKS,
 )

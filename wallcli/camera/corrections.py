@@ -20,14 +20,14 @@ shape a person does not make:
   differing) goes as completely as the whole-frame one; a person loses one frequency bin out of
   128 at most.
 - **exposure**: steps and slow drift of the whole frame's gain, found in
-  :mod:`wallcli.signal.exposure`.
+  :mod:`wallcli.camera.exposure`.
 
 ``correct`` divides the found gains out and returns what was found; ``merge`` sums a clip's
 findings into the JSON ``corrections`` list (``{"kind": "flicker", "hz", "amplitude", ...}``,
 ``{"kind": "exposure", "steps": [{"time", "size"}...]}``, ``{"kind": "drift", "amplitude"}``; a
 step cut by a window's end, taken as a ramp there, ``"partial": True``; ``white_balance``: :mod:`~.whitebalance`).
 Camera shake (``kind: "shake"``) is regressed out first, where the stream measured each frame's
-shift (:mod:`wallcli.signal.shake`, in :func:`correct_windows`).
+shift (:mod:`wallcli.camera.shake`, in :func:`correct_windows`).
 """
 from __future__ import annotations
 
@@ -36,8 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from wallcli.signal.exposure import _steps_and_drift, solve
-from wallcli.signal.whitebalance import balance, merge as merge_white_balance
+from wallcli.camera.exposure import _steps_and_drift, solve
+from wallcli.camera.whitebalance import balance, merge as merge_white_balance
 
 MAINS_HZ = (50.0, 60.0)
 MIN_LINE_HZ = 0.5  # slower aliases are drift's business
@@ -204,7 +204,7 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
     horizontal and vertical); all parts of a window are fitted together (a part that is all zero,
     such as a vertical plot not computed, is left out). ``shifts``: (n, T, 2) each sample's
     measured camera shift, when the stream registered its frames: the shake is regressed out
-    first (:mod:`wallcli.signal.shake`), then the light's nuisances are fitted on what is left.
+    first (:mod:`wallcli.camera.shake`), then the light's nuisances are fitted on what is left.
     Returns (corrected parts (float32), [findings per window]).
     """
     n = parts[0].shape[0]
@@ -258,7 +258,7 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
 def _unshake(raws: list[np.ndarray], shifts: np.ndarray) -> dict[str, Any] | None:
     """Regress the shake out of one window's parts [(bins, T, 3)], in place, all together (one
     camera moved them all); the finding, or None when the shifts explain nothing."""
-    from wallcli.signal.shake import unshake
+    from wallcli.camera.shake import unshake
 
     t = raws[0].shape[1]
     series = np.concatenate([r.transpose(1, 0, 2).reshape(t, -1) for r in raws], axis=1)

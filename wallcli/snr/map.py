@@ -1,5 +1,5 @@
 """Where on the wall is the signal? The SNR of every cell of a coarse grid over the frame, in the
-same decode as :mod:`wallcli.signal.snr`'s estimator (the seed's §3.2, per cell), for
+same decode as :mod:`wallcli.snr.estimate`'s estimator (the seed's §3.2, per cell), for
 ``snr --heatmap`` and ``snr --roi auto`` (the best rectangle of cells)."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 
 from wallcli.errors import WallcliError
 from wallcli.signal.blocks import Roi, rgb_grid
-from wallcli.signal.snr import MIN_FRAMES, footprint, powers_from_sums, snap_roi
+from wallcli.snr.estimate import MIN_FRAMES, footprint, powers_from_sums, snap_roi
 
 
 def grid_shape(w: int, h: int, long_side: int, fy: int = 1, fx: int = 1) -> tuple[int, int, int, int]:

@@ -1,5 +1,5 @@
 """Auto-exposure steps and slow drift of the whole frame's gain (one of the light nuisances of
-:mod:`wallcli.signal.corrections`, which finds mains flicker, calls :func:`_steps_and_drift` and
+:mod:`wallcli.camera.corrections`, which finds mains flicker, calls :func:`_steps_and_drift` and
 divides the gains out).
 
 The whole frame's gain, robustly (the median over the bins of each bin's relative change, so that

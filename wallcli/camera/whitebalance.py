@@ -1,7 +1,7 @@
 """Auto white balance hunting found per colour and divided out, before the grey corrections.
 
 A camera that re-estimates the illuminant's colour moves each colour's gain slowly and its own
-way (a few per cent over seconds). The exposure and drift fit (:mod:`wallcli.signal.exposure`)
+way (a few per cent over seconds). The exposure and drift fit (:mod:`wallcli.camera.exposure`)
 works on the colours summed, a gain common to all three; what differs between the colours was
 left in every profile, a whole-wall colour wave tens of times a person's signal, and the
 networks read it as one (issue 36: most clips' answers lost to a 1-3 % hunt).
@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from wallcli.signal.exposure import _steps_and_drift
+from wallcli.camera.exposure import _steps_and_drift
 
 DEGREE = 5  # a white balance hunts back and forth within a window: more than the light's cubic drift
 

@@ -208,16 +208,16 @@ def powers_from_sums(s1, s2, sd, dsum, frames: int, area: float, axes) -> tuple[
 class SnrAccumulator:
     """Feed decoded frames' planes with :meth:`update`; :meth:`result` gives every block size.
 
-    With ``corrections`` (:class:`wallcli.signal.corrections.Options`) and the video's frame rate
+    With ``corrections`` (:class:`wallcli.camera.corrections.Options`) and the video's frame rate
     ``fps``, the whole-frame light nuisances (aliased mains flicker, exposure steps, drift) are
     found on the measured pixels' row and column means and divided out of every pixel before the
     sums (each pixel by the gain of its row band, so rolling-shutter bands go too). The gains are
-    final a few seconds later (:class:`~wallcli.signal.corrections.LaggedGains`), so that many
+    final a few seconds later (:class:`~wallcli.camera.corrections.LaggedGains`), so that many
     frames' measured pixels wait in memory; :attr:`corrections` says what was found.
 
     With ``corrections.shake``, each frame's sub-pixel shift is measured on the ROI's luma line
     sums and the camera's shake is regressed out of every pixel's series at the end, from sums
-    (:class:`wallcli.signal.shake.ShakeSums`), as the classifiers do on their plots; from blocks
+    (:class:`wallcli.camera.shake.ShakeSums`), as the classifiers do on their plots; from blocks
     of 2x2 pixels up (kept per pixel, its sums cost three times the estimator's own work; single
     pixels' SNR is left uncorrected).
     """
@@ -251,14 +251,14 @@ class SnrAccumulator:
         self.levels = [n for n in self.scales if lat.th // n >= 1 and lat.tw // n >= 1]
         if self.shake and SHAKE_BLOCK in self.levels:
             from wallcli.signal.blocks import LumaShift
-            from wallcli.signal.shake import ShakeSums
+            from wallcli.camera.shake import ShakeSums
 
             self._register = LumaShift()
             self._shake = ShakeSums((3, lat.nty, lat.th // SHAKE_BLOCK, lat.ntx, lat.tw // SHAKE_BLOCK))
         if self.options is not None:
             from collections import deque
 
-            from wallcli.signal import corrections as corr
+            from wallcli.camera import corrections as corr
 
             self.row_band = corr.bands(lat.nty * lat.th)
             self.col_band = corr.bands(lat.ntx * lat.tw)
@@ -460,7 +460,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
 
     One builder for ``wallcli snr`` and ``wallcli scan`` (which feeds the accumulator from the
     decode that also makes the space-time plots), so both report the same fields, the one-line
-    ``verdict`` (:func:`~wallcli.signal.snr_verdict.snr_verdict`) included.  ``notes``:
+    ``verdict`` (:func:`~wallcli.snr.verdict.snr_verdict`) included.  ``notes``:
     the reader's warnings, listed before the estimator's own.
     """
     acc.finish()
@@ -486,7 +486,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
         "warnings": [*notes, *res.warnings],
         "corrections": acc.corrections,
     }
-    from wallcli.signal.snr_verdict import snr_verdict
+    from wallcli.snr.verdict import snr_verdict
 
     out["verdict"] = snr_verdict(out)  # here, not in the command: scan's snr object is this one too
     return out

@@ -1,4 +1,4 @@
-"""The view check's thresholds and the issues it names (see :mod:`wallcli.signal.view`): every
+"""The view check's thresholds and the issues it names (see :mod:`wallcli.view.check`): every
 threshold in units of the noise the clip itself shows, but for the floors that encode the method's
 own premise (``REL``: no hidden person changes the wall by that much; ``MIN_SHIFT``: a tripod's
 sub-pixel shake, which corrections deal with). Each says why it is what it is."""

@@ -8,8 +8,8 @@ from collections import deque
 
 import numpy as np
 
-from wallcli.signal.view_image import _block_side, _robust_sigma, _sampled_luma, _upper_median, _whole_blocks
-from wallcli.signal.view_limits import (
+from wallcli.view.image import _block_side, _robust_sigma, _sampled_luma, _upper_median, _whole_blocks
+from wallcli.view.limits import (
     CLIP_HI, CUT_CALM, CUT_CELLS, CUT_FRACTION, CUT_RATE, CUT_REACH, CUT_SIDE, CUT_SPIKE, DARK, HISTORY, K_CUT,
     MIN_USABLE, REL_CUT, SIGMA_FLOOR,
 )

@@ -19,19 +19,19 @@ from collections import deque
 
 import numpy as np
 
-from wallcli.signal.view_cut import CutWatch
-from wallcli.signal.view_image import (
+from wallcli.view.cut import CutWatch
+from wallcli.view.image import (
     _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
 )
-from wallcli.signal.view_light import _chroma, _objects, _relative_texture
-from wallcli.signal.view_limits import (
+from wallcli.view.light import _chroma, _objects, _relative_texture
+from wallcli.view.limits import (
     CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, GAP_EDGE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
     MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_REGISTER_SIDE, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
     REL, REL_EDGE,
     SHARP, SIGMA_FLOOR, TEX_TAU,
 )
-from wallcli.signal.overlay import merged
-from wallcli.signal.view_motion import _in_band, _motion_verdict, _shift_fits, _texture_match
+from wallcli.camera.overlay import merged
+from wallcli.view.motion import _in_band, _motion_verdict, _shift_fits, _texture_match
 from wallcli.wording import span_text
 
 # what other modules import from here (the thresholds live in view_limits)
