@@ -36,7 +36,7 @@ def main() -> None:
                             "empty, the SNR bands on all (not shipped with wallcli)",
              **{k: result[k] for k in KEYS if k in result}}
     block["source"] = ("an independent path-traced renderer (other code, box people, area lights, its own camera "
-                       "model), never trained on; since issue 35 the validation set: candidates are compared and "
+                       "model), never trained on; since 2026-11-26 the validation set: candidates are compared and "
                        "decided/undetermined thresholds fitted there, and a hidden set of the same kind judges")
     block["command"] = f"wallcli evaluate TRANSFER_DIR --task {result['task']} --json"
     if result.get("stages"):  # count answered in two stages: the figures are the pair's

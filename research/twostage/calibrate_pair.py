@@ -103,7 +103,7 @@ def main(argv=None) -> int:
 
         act = load_model("activity", a.activity)
         card = read_card(Path(a.count))
-        block["fitted_on"] = (f"the transfer set (the validation set since issue 35; {len(clips)} clips, never trained on), "
+        block["fitted_on"] = (f"the transfer set (the validation set since 2026-11-26; {len(clips)} clips, never trained on), "
                               "clip answers of the two-stage pair with the light corrections and the view check on")
         block["two_fold"] = {"decided": cv_n, "right": cv_k, "clips": len(clips),
                              "how": "thresholds fitted on alternate clips, decided answers counted on the others, both ways"}
