@@ -100,3 +100,22 @@ def test_fields_are_brought_to_one_instant(offset):
         y = out[k].planes.y
         top, bottom = y[0::2].mean() / wall[0::2].mean(), y[1::2].mean() / wall[1::2].mean()
         assert abs(top - _light(k)) < 0.001 and abs(bottom - top) < 0.0005 < abs(_light(k + offset) - _light(k))
+
+
+def test_a_clip_shown_progressive_is_not_read_further(woven):
+    """Once the light's changes have shown both fields at one instant beyond doubt (over 4 s), the
+    check stops reading (the decision it would reach stays 'progressive'); a woven clip is still
+    found interlaced, never taken for progressive first."""
+    from wallcli.camera.interlace import InterlaceFilter
+    from wallcli.io.video import open_video
+
+    seen = {}
+    for name in ("progressive", "tff", "bff"):
+        with open_video(str(woven[name])) as reader:
+            f = InterlaceFilter(reader)
+            n = sum(1 for _ in f.frames())
+        seen[name] = (f.progressive, f.delta, f._n, n)
+    progressive, delta, read, frames = seen["progressive"]
+    assert progressive and delta is None and read < frames - 30, seen
+    assert not seen["tff"][0] and seen["tff"][1] == 0.5, seen
+    assert not seen["bff"][0] and seen["bff"][1] == -0.5, seen

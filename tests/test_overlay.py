@@ -259,3 +259,15 @@ def test_simulate_starts_the_clock_where_asked(tmp_path):
     with pytest.raises(SystemExit) as exc:
         main(["simulate", "-o", str(tmp_path / "bad.mkv"), *SIM, "--overlay", "--clock-start", "25:00:00"])
     assert exc.value.code not in (0, None)
+
+
+@pytest.mark.parametrize("shape,top", [((90, 160), 256), ((91, 161), 10), ((3, 3), 2), ((1, 1), 256), ((2, 1), 5)])
+def test_the_noise_figures_read_off_a_histogram_are_numpys(shape, top):
+    """The step threshold's median and 90th percentile of 8-bit differences, read off their
+    histogram (a tenth of sorting them), are numpy's order statistics exactly."""
+    from wallcli.camera.overlay import _median_p90
+
+    a = np.random.default_rng(sum(shape) + top).integers(0, top, shape).astype(np.uint8)
+    median, p90 = _median_p90(a)
+    assert median == float(np.median(a.astype(np.float32)))
+    assert p90 == pytest.approx(float(np.percentile(a.astype(np.float32), 90)), abs=1e-4)
