@@ -410,7 +410,8 @@ def _finish(p, timeout):
 
 
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("args,head", [(["count", "-", "--json"], 0), (["count", "-", "--follow"], 30_000)])
+@pytest.mark.parametrize("args,head", [(["count", "-", "--json"], 0), (["count", "-", "--json"], 30_000),
+                                       (["count", "-", "--follow"], 30_000)])
 def test_a_signal_ends_a_command_whose_stdin_stalled(mkv, sig, args, head):
     import signal
     import time

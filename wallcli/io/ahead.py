@@ -78,6 +78,12 @@ class Ahead:
         worker, q, stop = self._running
         self._running = None
         stop.set()
+        if worker.is_alive():
+            # the thread may wait inside the reader for a frame that is not coming (a stalled
+            # stream, its consumer interrupted): the reader stops its decoder and wakes it
+            interrupt = getattr(self.reader, "interrupt", None)
+            if interrupt is not None:
+                interrupt()
         while worker.is_alive():  # unblock a producer waiting on a full queue
             try:
                 q.get_nowait()

@@ -548,6 +548,8 @@ class VideoReader:
                                "using the frames before the damage")
                 elif kind == "error":
                     raise item
+                elif kind == "stopped":  # interrupted from another thread (interrupt)
+                    return
                 else:
                     if item:
                         self._warn(f"{self.source}: skipped {item} corrupt packet(s)/frame(s)")
@@ -610,6 +612,19 @@ class VideoReader:
             except queue.Empty:
                 thread.join(timeout=0.05)
         self._worker = None
+
+    def interrupt(self) -> None:
+        """Stop decoding now, from a thread other than the one reading :meth:`frames` (which may
+        wait there for a frame of a stalled stream): the decoder thread is stopped, its input
+        closed, and the reader's consumer wakes to the end of its frames."""
+        worker = getattr(self, "_worker", None)
+        if worker is None:
+            return
+        self._stop_worker()
+        try:
+            worker[1].put_nowait(("stopped", None))
+        except queue.Full:  # frames or the end are still queued: the consumer wakes to those
+            pass
 
     def close(self) -> None:
         self._stop_worker()
