@@ -68,21 +68,26 @@ class TemporalNoise:
         if self._corners is None:
             self._corners, self._shape = _tiles(*y.shape), y.shape
             self._d = np.zeros((2, len(self._corners)))
+            r, c = (np.array([k[i] for k in self._corners], np.intp).reshape(-1, 1, 1) for i in (0, 1))
+            self._at = (r + np.arange(TILE).reshape(1, -1, 1), c + np.arange(TILE + 2).reshape(1, 1, -1))
         if not self._corners or y.shape != self._shape:
             return
         if getattr(frame, "gap", 0.0):
             self._hist = []
-        luma = np.stack([y[r:r + TILE, c:c + TILE + 2] for r, c in self._corners]).astype(np.float32)
-        z = luma[:, :, 2:] - luma[:, :, :-2]
+        # every tile in one gather, in the plane's own integer codes: the differences and their
+        # squares are exact integers (summed in float64), a few numpy calls a frame
+        luma = y[self._at]
+        z = luma[:, :, 2:].astype(np.int32) - luma[:, :, :-2]
         if self._hist:
             prev_luma, prev_z = self._hist[-1]
-            same = np.abs(luma[:, :, :TILE] - prev_luma[:, :, :TILE]).reshape(len(z), TILE // 8, 8, TILE // 8, 8)
-            held = same.max(axis=(2, 4)) == 0
+            same = np.equal(luma[:, :, :TILE], prev_luma[:, :, :TILE]).reshape(len(z), TILE // 8, 8, TILE // 8, 8)
+            held = same.all(axis=(2, 4))
             self._blocks += held.size
-            self._held += int(held.sum())
+            self._held += int(np.count_nonzero(held))
             if len(self._hist) == 2:
-                self._d[0] += np.square(z - prev_z).sum(axis=(1, 2))
-                self._d[1] += np.square(z - self._hist[0][1]).sum(axis=(1, 2))
+                for k, before in ((0, prev_z), (1, self._hist[0][1])):
+                    dz = (z - before).astype(np.float64)
+                    self._d[k] += np.einsum("ijk,ijk->i", dz, dz)
                 self.pairs += 1
         self._hist = (self._hist + [(luma, z)])[-2:]
 
