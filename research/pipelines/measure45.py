@@ -135,16 +135,13 @@ def make(args) -> None:
 
 
 def run(args) -> None:
+    sys.path.insert(0, str(Path(__file__).parent))
+    from measure_kind import resume
+
     from wallcli.batch.analyse import analyse
-    from wallcli.infer.twostage import load_classifier
 
     out = Path(args.out)
-    index = json.loads((out / "index.json").read_text())
-    models = {t: load_classifier(t) for t in ("count", "activity")}
-    path = out / f"results_{args.tag}.jsonl"
-    done = set()
-    if path.exists():
-        done = {json.loads(line)["file"] for line in path.read_text().splitlines() if line.strip()}
+    index, models, path, done = resume(out, args.tag)
     with open(path, "a") as f:
         for e in index:
             if e["file"] in done or (args.kind and e["kind"] not in args.kind) or not (out / e["file"]).exists():

@@ -91,17 +91,25 @@ def make(args) -> None:
     (out / "index.json").write_text(json.dumps(index, indent=1))
 
 
-def run(args) -> None:
-    from wallcli.batch.analyse import analyse
+def resume(out: Path, tag: str):
+    """(the index, both shipped models, the results file of ``tag``, the files it already holds):
+    a run picks up where an earlier one stopped."""
     from wallcli.infer.twostage import load_classifier
 
-    out = Path(args.out)
     index = json.loads((out / "index.json").read_text())
     models = {t: load_classifier(t) for t in ("count", "activity")}
-    path = out / f"results_{args.tag}.jsonl"
+    path = out / f"results_{tag}.jsonl"
     done = set()
     if path.exists():
         done = {json.loads(line)["file"] for line in path.read_text().splitlines() if line.strip()}
+    return index, models, path, done
+
+
+def run(args) -> None:
+    from wallcli.batch.analyse import analyse
+
+    out = Path(args.out)
+    index, models, path, done = resume(out, args.tag)
     with open(path, "a") as f:
         for k, e in enumerate(index):
             if e["file"] in done or (args.kind and e["kind"] not in ("clean", *args.kind)):

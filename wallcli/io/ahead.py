@@ -84,14 +84,20 @@ class Ahead:
             interrupt = getattr(self.reader, "interrupt", None)
             if interrupt is not None:
                 interrupt()
-        while worker.is_alive():  # unblock a producer waiting on a full queue
-            try:
-                q.get_nowait()
-            except queue.Empty:
-                worker.join(timeout=0.05)
+        join_draining(worker, q)
 
     def __enter__(self) -> "Ahead":
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def join_draining(thread: threading.Thread, q: queue.Queue) -> None:
+    """Wait for ``thread`` to end, emptying ``q`` meanwhile: a producer blocked on the full queue
+    then gets to see that it was told to stop."""
+    while thread.is_alive():
+        try:
+            q.get_nowait()
+        except queue.Empty:
+            thread.join(timeout=0.05)

@@ -606,11 +606,9 @@ class VideoReader:
         stop.set()
         if self._input is not None:
             self._input.close()  # the decoder may wait in its read()
-        while thread.is_alive():
-            try:  # unblock the producer if it waits on a full queue
-                q.get_nowait()
-            except queue.Empty:
-                thread.join(timeout=0.05)
+        from wallcli.io.ahead import join_draining
+
+        join_draining(thread, q)  # (the producer may wait on a full queue)
         self._worker = None
 
     def interrupt(self) -> None:
