@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from wallcli.signal.window import (NORMALIZATION, NORMALIZATION_TEXT, NORMALIZATION_V2, NORMALIZATION_V3, normalize_window,
-                                   window_signal_db)
+                                   window_power_db, window_signal_db)
 
 
 def _window(strong: float, faint: float, sigma: float = 1.0, seed: int = 0) -> np.ndarray:
@@ -95,3 +95,57 @@ def test_signal_db_measures_people_not_light_changes():
     # two plots add their powers; a batch gives one figure per window
     both = window_signal_db([(np.stack([person, flicker_only]), np.stack([off_p, off]))])
     assert both.shape == (2,) and both[0] > both[1]
+
+
+def _wall(noise: np.ndarray, person: float, seed: int = 0):
+    """(window relative to its level, the level) of a flat lit wall with ``noise`` (64, 256, 3)
+    and a person's shadow, ``person`` codes deep, crossing it."""
+    t = np.arange(256) / 30.0
+    level = np.full((64, 3), 120.0)
+    centre = 10 + 40 * t / t[-1]
+    shadow = person * np.exp(-((np.arange(64)[:, None] - centre[None]) / 8.0) ** 2)[..., None]
+    raw = level[:, None, :] + noise - shadow
+    return (raw - level[:, None, :]).astype(np.float32), level.astype(np.float32)
+
+
+def _blend(x: np.ndarray, a: float) -> np.ndarray:
+    """A camera's temporal noise reduction along time: y = (1 - a) x + a y_prev."""
+    y = np.empty_like(x)
+    y[:, 0] = x[:, 0]
+    for i in range(1, x.shape[1]):
+        y[:, i] = (1 - a) * x[:, i] + a * y[:, i - 1]
+    return y
+
+
+def test_a_codecs_held_residue_is_not_read_as_a_signal():
+    # each bin's noise held for 10-20 frames, then stepped (a codec's skipped blocks), bin by bin
+    rng = np.random.default_rng(3)
+    held = np.zeros((64, 256, 3))
+    for b in range(64):
+        edges = np.cumsum(rng.integers(10, 21, 30))
+        steps = np.repeat(rng.normal(0, 1.0, (31, 3)), np.diff(np.concatenate([[0], edges, [10 ** 6]]))[:31].clip(0), 0)
+        held[b] = steps[:256]
+    empty = _wall(held + rng.normal(0, 0.05, held.shape), person=0.0)
+    # the whole power over frame-to-frame differences reads the steps as a strong signal
+    assert window_power_db([empty])[()] > 5
+    assert window_signal_db([empty])[()] < -3
+    # a person stays a signal with the same residue
+    someone = _wall(held + rng.normal(0, 0.05, held.shape), person=3.0)
+    assert window_signal_db([someone])[()] > window_signal_db([empty])[()] + 8
+
+
+def test_a_temporal_noise_blend_does_not_raise_the_signal():
+    rng = np.random.default_rng(4)
+    white = rng.normal(0, 1.0, (64, 256, 3))
+    clean = _wall(white, person=4.0)
+    blended = _wall(_blend(white, 0.65), person=4.0)
+    # the blend takes noise off the high frequencies only: the frame-to-frame figure rises 11 dB
+    assert window_power_db([blended])[()] > window_power_db([clean])[()] + 6
+    assert abs(window_signal_db([blended])[()] - window_signal_db([clean])[()]) < 3
+
+
+def test_on_white_noise_the_coherent_signal_is_the_whole_signal():
+    rng = np.random.default_rng(5)
+    for person in (4.0, 8.0, 16.0):  # 1-13 dB
+        w = _wall(rng.normal(0, 1.0, (64, 256, 3)), person=person)
+        assert abs(window_signal_db([w])[()] - window_power_db([w])[()]) < 1.5

@@ -1,8 +1,8 @@
 """Decided or undetermined: when an answer may be relied upon, from the model's own validation.
 
 A model card's ``confidence`` block holds, per answer (class) and per band of measured signal
-(``window_signal_db``: the plot's power over its frame-to-frame noise, whole-wall light changes
-removed), the smallest probability at which that answer was right at least ``level`` of the time
+(``window_signal_db``: the power of what changes the plot's bins together over the noise at a
+person's frequencies, whole-wall light changes removed), the smallest probability at which that answer was right at least ``level`` of the time
 on a validation set the model never trained on. An answer is confident when its probability
 reaches the threshold of its class in its signal band; otherwise it is *undetermined*, with a
 one-line reason. ``label`` and ``probabilities`` keep their meaning either way.

@@ -1,7 +1,7 @@
 """Physical features of a window's two space-time plots: how strong, how spread, how periodic.
 
 Nineteen numbers per window, each a property of the light the people change, not of a room:
-per plot, the power over the frame-to-frame noise (``window_signal_db``), the whole-wall share
+per plot, the power over the frame-to-frame noise (``window_power_db``), the whole-wall share
 (what every position shares), the first two singular values' shares (how many independent
 patterns), the whole-wall signal's spectral peak (its share and its frequency) and the
 frame-to-frame change; then, of the vertical plot, the share of its energy in the upper half, the
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.signal.window import window_signal_db
+from wallcli.signal.window import window_power_db
 
 NAMES = ["h_db", "h_wall_share", "h_rank1", "h_rank2", "h_peak_share", "h_peak_hz", "h_log_change",
          "v_db", "v_wall_share", "v_rank1", "v_rank2", "v_peak_share", "v_peak_hz", "v_log_change",
@@ -31,7 +31,7 @@ def _centred(w: np.ndarray) -> np.ndarray:
 
 def _plot(w: np.ndarray, off: np.ndarray) -> np.ndarray:
     x = _centred(w)
-    db = window_signal_db([(w, off)])
+    db = window_power_db([(w, off)])
     tot = (x ** 2).mean((1, 2)) + 1e-20
     g = x.mean(1)
     share = (g ** 2).mean(1) / tot

@@ -180,24 +180,113 @@ def remove_light_changes(x: np.ndarray, offset: np.ndarray | None) -> np.ndarray
 
 
 SIGNAL_FLOOR_DB = -30.0
+# The signal is what changes the wall coherently: a hidden person's light reaches many bins at
+# once, so it lives in the plot's coarse spatial components (a DCT across the bins, under
+# COARSE of them), while the fine ones (from COARSE on) hold what changes bin by bin: the camera's
+# noise and a codec's residue. A codec that holds a block's noise for frames and then steps it
+# changes slowly, so its residue survives the frame-to-frame noise estimate and was read as signal
+# (HD CRF 23 exports of empty rooms: 0.4-15 dB); bin by bin, it is as strong in the fine
+# components as in the coarse ones at every frequency, and is taken off with them.
+COARSE = 0.25  # of the bins
+MIN_BINS = 16  # fewer bins: no spatial split (the plot's whole power over its noise, as before)
+# The noise that competes with a person is the noise at a person's frequencies. Frame-to-frame
+# differences read it at the highest ones, which is the same only for white noise: a camera's
+# temporal noise reduction, a codec's held blocks and the resampling of a 24 fps clip to 30 all
+# take noise off the high frequencies and leave the low ones. How much is read where a person's
+# light is not (each bin less its neighbours' mean), at SLOW_HZ against frame to frame; the
+# frame-to-frame figure is scaled up by that ratio where it is over 1 (:func:`_colour`).
+SLOW_HZ = (0.3, 2.5)
+# The fine components' power at one frequency is a mean over the three colours of two-degree
+# chi-square variables (real, imaginary): its median is this share of its mean.
+_MEDIAN_CHI2_6 = 0.8907
 
 
-def window_signal_db(parts: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
-    """How strong the signal of plot windows is, in dB over their noise, after the whole-wall
-    light changes are removed (the estimator of paper suppl. §3.2, on the plots).
+def _dct_rows(n: int) -> np.ndarray:
+    k = np.arange(n)[:, None]
+    b = np.cos(np.pi * (np.arange(n)[None] + 0.5) * k / n)
+    return b / np.linalg.norm(b, axis=1, keepdims=True)
 
-    ``parts``: [(windows (..., bins, T, 3), offsets (..., bins, 3))], e.g. the horizontal and the
-    vertical plot. Noise power = half the mean square of the differences between consecutive
-    samples; signal power = total power minus noise. Floored at SIGNAL_FLOOR_DB (a window of
-    pure noise measures about 0 signal, whose ratio is meaningless).
-    """
+
+def _spectrum(y: np.ndarray) -> np.ndarray:
+    """(..., bins, T, 3) light-removed windows -> (..., bins - 1, T // 2 + 1) the power of each
+    spatial component but the mean (a DCT across the bins) at each temporal frequency, per sample
+    (tapered; the colours averaged)."""
+    bins, T = y.shape[-3], y.shape[-2]
+    z = np.einsum("kb,...btc->...ktc", _dct_rows(bins)[1:], y)  # component 0 (the wall's mean) is gone
+    taper = np.hanning(T)
+    spec = np.fft.rfft(z * taper[:, None], axis=-2)
+    return np.mean(spec.real ** 2 + spec.imag ** 2, axis=-1) / np.sum(taper * taper)
+
+
+def _coherent(power: np.ndarray, bins: int) -> np.ndarray:
+    """The power of the windows' spatially coherent change, per sample and bin, from their
+    :func:`_spectrum`: the coarse components' power at each frequency less the level the fine
+    components show at it (their median over components, for chi-square's median)."""
+    coarse = max(2, int(round(COARSE * bins)))
+    white = np.median(power[..., coarse - 1:, :], axis=-2) / _MEDIAN_CHI2_6  # (..., F)
+    return np.sum(np.mean(power[..., :coarse - 1, :] - white[..., None, :], axis=-1), axis=-1) / bins
+
+
+def _colour(power: np.ndarray, bins: int, T: int, step: np.ndarray, fps: float) -> np.ndarray | None:
+    """How much more noise the windows hold at a person's frequencies (SLOW_HZ) than their
+    frame-to-frame figure ``step`` says (1: white), read where a person's light is not: the fine
+    spatial components' level in their :func:`_spectrum` (the median over components at each
+    frequency, for chi-square's median); None where the window has no such frequency."""
+    f = np.fft.rfftfreq(T, 1.0 / fps)
+    slow = (f >= SLOW_HZ[0]) & (f <= SLOW_HZ[1])
+    if not slow.any():
+        return None
+    coarse = max(2, int(round(COARSE * bins)))
+    low = np.mean(np.median(power[..., coarse - 1:, :][..., slow], axis=-2), axis=-1) / _MEDIAN_CHI2_6
+    return low / np.maximum(step, 1e-30)
+
+
+def window_power_db(parts: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """The plot windows' whole power less their frame-to-frame noise, over that noise, in dB (the
+    estimator of paper suppl. §3.2, whole-wall light changes removed; floored at SIGNAL_FLOOR_DB).
+    What ``signal_db`` was until 2026-11-27, kept as a feature (``wallcli.signal.features``) because
+    the shipped models were trained on it; :func:`window_signal_db` is the figure reported."""
     total = noise = 0.0
     for x, off in parts:
         y = remove_light_changes(x, off)
         total = total + np.mean(np.square(y), axis=(-3, -2, -1))
         noise = noise + 0.5 * np.mean(np.square(np.diff(y, axis=-2)), axis=(-3, -2, -1))
-    sig = np.asarray(total - noise, np.float64)
-    ratio = sig / np.maximum(np.asarray(noise, np.float64), 1e-30)
+    ratio = np.asarray(total - noise, np.float64) / np.maximum(np.asarray(noise, np.float64), 1e-30)
+    return np.maximum(10 * np.log10(np.maximum(ratio, 1e-30)), SIGNAL_FLOOR_DB)
+
+
+def window_signal_db(parts: list[tuple[np.ndarray, np.ndarray]], fps: float = CANONICAL_FPS) -> np.ndarray:
+    """How strong the signal of plot windows is, in dB over their noise, after the whole-wall
+    light changes are removed.
+
+    ``parts``: [(windows (..., bins, T, 3), offsets (..., bins, 3))], e.g. the horizontal and the
+    vertical plot, sampled at ``fps``. Signal power = the power of what changes the bins together
+    (the coarse spatial components less the fine ones' level, :func:`_coherent`), so that a codec's
+    residue, which changes bin by bin, is not read as a person. Noise power = half the mean square
+    of the differences between consecutive samples (paper suppl. §3.2), scaled up where the noise
+    at a person's frequencies is larger (what a blend, a codec or a resampling kept there,
+    :func:`_colour`). Floored at SIGNAL_FLOOR_DB (a window of pure noise measures about 0 signal,
+    whose ratio is meaningless).
+    """
+    signal = noise = 0.0
+    colour = None
+    for i, (x, off) in enumerate(parts):
+        y = remove_light_changes(x, off)
+        n = 0.5 * np.mean(np.square(np.diff(y, axis=-2)), axis=(-3, -2, -1))
+        if y.shape[-3] >= MIN_BINS and y.shape[-2] >= 8:
+            power = _spectrum(y)
+            s = _coherent(power, y.shape[-3])
+            if i == 0:
+                # the noise's colour is the camera's; it is read on the first plot (the horizontal
+                # one: a column averages the wall's rows, so a masked line of text, which fills
+                # whole rows of the vertical plot, is a small part of each)
+                colour = _colour(power, y.shape[-3], y.shape[-2], n, fps)
+        else:
+            s = np.mean(np.square(y), axis=(-3, -2, -1)) - n
+        signal, noise = signal + s, noise + n
+    if colour is not None:
+        noise = noise * np.maximum(colour, 1.0)
+    ratio = np.asarray(signal, np.float64) / np.maximum(np.asarray(noise, np.float64), 1e-30)
     return np.maximum(10 * np.log10(np.maximum(ratio, 1e-30)), SIGNAL_FLOOR_DB)
 
 
