@@ -3,6 +3,7 @@ the ceiling that the checks leave for any speed-up of theirs. Each configuration
 process (monkeypatched in-process, the CLI's own path otherwise), alternating with decode-only.
 
     .venv/bin/python research/speed/ablate.py bench/out/export_t002_p1_walking_900_crf18.mp4 --rounds 2
+    .venv/bin/python research/speed/ablate.py bench/out/export_t002_p1_walking_900_crf18.mp4 --command stplot
 
 Configurations: every check on (as shipped); each of overlay, repeats, interlace, TNR, the view
 check and the shift registration off alone; all the camera checks and the view check off; and
@@ -19,6 +20,7 @@ import statistics
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 PARTS = ("overlay", "repeats", "interlace", "tnr", "view", "shift")
 CONFIGS = ["", *PARTS, "overlay,repeats,interlace,tnr,view", ",".join(PARTS)]
@@ -48,7 +50,15 @@ def _switch_off(off: set[str]) -> None:
         blocks.LineShift.__call__ = lambda self, s: 0.0
 
 
-def _child(clip: str, config: str) -> None:
+def _args(command: str, clip: str) -> list[str]:
+    if command == "stplot":  # the plots written, as `wallcli stplot CLIP -o plots.npz` writes them
+        import tempfile
+
+        return ["stplot", clip, "-o", str(Path(tempfile.gettempdir()) / "wallcli_ablate.npz"), "--force"]
+    return ["count", clip, "--json"]
+
+
+def _child(clip: str, config: str, command: str) -> None:
     t0 = time.perf_counter()
     if config == "decode":
         import av
@@ -64,7 +74,7 @@ def _child(clip: str, config: str) -> None:
 
         with contextlib.redirect_stdout(io.StringIO()):
             try:
-                main(["count", clip, "--json"])
+                main(_args(command, clip))
             except SystemExit as exc:
                 if exc.code:
                     raise
@@ -72,9 +82,9 @@ def _child(clip: str, config: str) -> None:
     print(json.dumps({"seconds": time.perf_counter() - t0, "cpu": ru.ru_utime + ru.ru_stime}))
 
 
-def _run(clip: str, config: str) -> dict:
-    out = subprocess.run([sys.executable, __file__, clip, "--child", config], capture_output=True, text=True,
-                         check=True)
+def _run(clip: str, config: str, command: str) -> dict:
+    out = subprocess.run([sys.executable, __file__, clip, "--child", config, "--command", command],
+                         capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -82,22 +92,23 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("clip")
     ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--command", choices=("count", "stplot"), default="count")
     ap.add_argument("--child")
     args = ap.parse_args()
     if args.child is not None:
-        return _child(args.clip, args.child)
+        return _child(args.clip, args.child, args.command)
     ratios = {c: [] for c in CONFIGS}
     cpu = {c: [] for c in CONFIGS}
     dec_cpu = []
     for _ in range(args.rounds):
         for c in CONFIGS:
-            d = _run(args.clip, "decode")
-            r = _run(args.clip, c)
+            d = _run(args.clip, "decode", args.command)
+            r = _run(args.clip, c, args.command)
             ratios[c].append(d["seconds"] / r["seconds"])
             cpu[c].append(r["cpu"])
             dec_cpu.append(d["cpu"])
     print(f"decode-only: {statistics.median(dec_cpu):.2f} CPU s (median of {len(dec_cpu)})")
-    print("| switched off | count / decode-only, wall (median; runs) | count's CPU s |")
+    print(f"| switched off | {args.command} / decode-only, wall (median; runs) | {args.command}'s CPU s |")
     print("|---|---|---|")
     for c in CONFIGS:
         print(f"| {c or 'nothing (as shipped)'} | {statistics.median(ratios[c]):.2f} "
