@@ -193,7 +193,7 @@ MIN_BINS = 16  # fewer bins: no spatial split (the plot's whole power over its n
 # differences read it at the highest ones, which is the same only for white noise: a camera's
 # temporal noise reduction, a codec's held blocks and the resampling of a 24 fps clip to 30 all
 # take noise off the high frequencies and leave the low ones. How much is read where a person's
-# light is not (each bin less its neighbours' mean), at SLOW_HZ against frame to frame; the
+# light is not (the fine spatial components), at SLOW_HZ against frame to frame; the
 # frame-to-frame figure is scaled up by that ratio where it is over 1 (:func:`_colour`).
 SLOW_HZ = (0.3, 2.5)
 # The fine components' power at one frequency is a mean over the three colours of two-degree
