@@ -6,22 +6,16 @@ spatially smooth), its temporal spectrum at the signal's frequencies against its
 """
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import sys
 
 import numpy as np
+from windows import clip_windows
+
+from wallcli.signal.window import _dct_rows
 
 LOW = (0.3, 2.5)
 HIGH = (6.0, 12.0)
-
-
-def dct_basis(n: int) -> np.ndarray:
-    k = np.arange(n)[:, None]
-    x = np.arange(n)[None]
-    b = np.cos(np.pi * (x + 0.5) * k / n)
-    return b / np.linalg.norm(b, axis=1, keepdims=True)
 
 
 def probe(ys, fps=30.0, kcuts=(8, 16, 32)):
@@ -30,7 +24,7 @@ def probe(ys, fps=30.0, kcuts=(8, 16, 32)):
         L = H = Hy = 0.0
         for y in ys:  # (n, bins, T, 3)
             n_b, T = y.shape[-3], y.shape[-2]
-            B = dct_basis(n_b)[kc:]  # fine components
+            B = _dct_rows(n_b)[kc:]  # fine components
             z = np.einsum("kb,nbtc->nktc", B, y)
             w = np.hanning(T)
             f = np.fft.rfftfreq(T, 1 / fps)
@@ -46,31 +40,12 @@ def probe(ys, fps=30.0, kcuts=(8, 16, 32)):
 
 
 def main() -> None:
-    from wallcli.infer import windows
-    from wallcli.signal.window import remove_light_changes
-    from wallcli.cli.app import main as cli
-
-    got = []
-    orig = windows.window_signal_db
-
-    def tap(parts):
-        db = orig(parts)
-        got.append((db, [remove_light_changes(x, off) for x, off in parts]))
-        return db
-
-    windows.window_signal_db = tap
     with open(sys.argv[1], "a") as fh:
         for clip in sys.argv[2:]:
-            got.clear()
-            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-                try:
-                    cli(["count", clip, "--json"])
-                except SystemExit:
-                    pass
-            if not got:
+            got = clip_windows(clip)
+            if got is None:
                 continue
-            dbs = np.concatenate([np.atleast_1d(g[0]) for g in got])
-            ys = [np.concatenate([g[1][i] for g in got]) for i in range(len(got[0][1]))]
+            dbs, ys = got
             total = sum(np.mean(y ** 2, axis=(-3, -2, -1)) for y in ys)
             diffn = sum(0.5 * np.mean(np.diff(y, axis=-2) ** 2, axis=(-3, -2, -1)) for y in ys)
             rec = {"clip": clip, "db_old": dbs.tolist(), "total": total.tolist(), "diffnoise": diffn.tolist(),

@@ -8,42 +8,22 @@ until its hold is over. Kurtosis of the lag-1 differences: 3 for Gaussian noise,
 """
 from __future__ import annotations
 
-import contextlib
-import io
 import sys
 
 import numpy as np
+from windows import clip_windows
 
 LAGS = (1, 2, 4, 8, 16)
 
 
 def main() -> None:
-    from wallcli.infer import windows
-    from wallcli.signal.window import remove_light_changes
-    from wallcli.cli.app import main as cli
-
-    got = []
-    orig = windows.window_signal_db
-
-    def tap(parts):
-        db = orig(parts)
-        got.append((db, [remove_light_changes(x, off) for x, off in parts]))
-        return db
-
-    windows.window_signal_db = tap
     print("clip | signal_db | N(k)/N(1), k = " + ", ".join(map(str, LAGS[1:])) + " | kurtosis(dy) | zero share")
     for clip in sys.argv[1:]:
-        got.clear()
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            try:
-                cli(["count", clip, "--json"])
-            except SystemExit:
-                pass
-        if not got:
+        got = clip_windows(clip)
+        if got is None:
             print(clip, "no windows")
             continue
-        dbs = np.concatenate([np.atleast_1d(g[0]) for g in got])
-        ys = [np.concatenate([g[1][i] for g in got]) for i in range(len(got[0][1]))]
+        dbs, ys = got
         n = {k: sum(0.5 * np.mean((y[..., k:, :] - y[..., :-k, :]) ** 2) for y in ys) for k in LAGS}
         d = np.concatenate([np.diff(y, axis=-2).ravel() for y in ys])
         kurt = float(np.mean(d ** 4) / np.mean(d ** 2) ** 2)

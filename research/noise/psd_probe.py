@@ -7,12 +7,11 @@ an AR(1) fit of its high-frequency spectrum (white-equivalent noise level at low
 """
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import sys
 
 import numpy as np
+from windows import clip_windows
 
 A_GRID = np.linspace(0.0, 0.95, 96)
 
@@ -45,33 +44,12 @@ def ar1_fit(P: np.ndarray, T: int, fps: float, lo: float, hi: float):
 
 
 def main() -> None:
-    out = sys.argv[1]
-    from wallcli.infer import windows
-    from wallcli.signal.window import remove_light_changes
-    from wallcli.cli.app import main as cli
-
-    got = []
-    orig = windows.window_signal_db
-
-    def tap(parts):
-        db = orig(parts)
-        ys = [remove_light_changes(x, off) for x, off in parts]
-        got.append((db, ys))
-        return db
-
-    windows.window_signal_db = tap
-    with open(out, "a") as fh:
+    with open(sys.argv[1], "a") as fh:
         for clip in sys.argv[2:]:
-            got.clear()
-            with contextlib.redirect_stdout(io.StringIO()):
-                try:
-                    cli(["count", clip, "--json"])
-                except SystemExit:
-                    pass
-            if not got:
+            got = clip_windows(clip)
+            if got is None:
                 continue
-            dbs = np.concatenate([np.atleast_1d(g[0]) for g in got])
-            ys = [np.concatenate([g[1][i] for g in got]) for i in range(len(got[0][1]))]
+            dbs, ys = got
             T = ys[0].shape[-2]
             P = spectrum(ys)
             total = sum(np.mean(y ** 2, axis=(-3, -2, -1)) for y in ys) / len(ys)

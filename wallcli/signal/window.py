@@ -207,6 +207,11 @@ def _dct_rows(n: int) -> np.ndarray:
     return b / np.linalg.norm(b, axis=1, keepdims=True)
 
 
+def _coarse(bins: int) -> int:
+    """How many of ``bins`` DCT components are coarse (the mean among them)."""
+    return max(2, int(round(COARSE * bins)))
+
+
 def _spectrum(y: np.ndarray) -> np.ndarray:
     """(..., bins, T, 3) light-removed windows -> (..., bins - 1, T // 2 + 1) the power of each
     spatial component but the mean (a DCT across the bins) at each temporal frequency, per sample
@@ -223,7 +228,7 @@ def _coherent(power: np.ndarray, bins: int) -> np.ndarray:
     """The power of the windows' spatially coherent change, per sample and bin, from their
     :func:`_spectrum`: the coarse components' power at each frequency less the level the fine
     components show at it (their median over components, for chi-square's median)."""
-    coarse = max(2, int(round(COARSE * bins)))
+    coarse = _coarse(bins)
     white = np.median(power[..., coarse - 1:, :], axis=-2) / _MEDIAN_CHI2_6  # (..., F)
     return np.sum(np.mean(power[..., :coarse - 1, :] - white[..., None, :], axis=-1), axis=-1) / bins
 
@@ -237,7 +242,7 @@ def _colour(power: np.ndarray, bins: int, T: int, step: np.ndarray, fps: float) 
     slow = (f >= SLOW_HZ[0]) & (f <= SLOW_HZ[1])
     if not slow.any():
         return None
-    coarse = max(2, int(round(COARSE * bins)))
+    coarse = _coarse(bins)
     low = np.mean(np.median(power[..., coarse - 1:, :][..., slow], axis=-2), axis=-1) / _MEDIAN_CHI2_6
     return low / np.maximum(step, 1e-30)
 
