@@ -64,7 +64,8 @@ def _register() -> None:
 
     from wallcli.cli.helpstyle import Command
 
-    for name in ("stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate", "report", "scan"):
+    for name in ("stplot", "amplify", "snr", "count", "activity", "track", "simulate", "train", "evaluate", "report",
+                 "scan"):
         app.command(name, cls=Command)(getattr(importlib.import_module(f"wallcli.cli.{name}"), name))
 
 

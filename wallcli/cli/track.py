@@ -1,0 +1,126 @@
+"""``wallcli track INPUT``: where along the wall each moving person was, over time."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from wallcli.cli.common import (PNG_NAME, ROI_HELP, check_png_names, corrections_of, force_help, input_argument,
+                                number_option, parse_roi, refuse_view, stall_option, strict_option, stream_option,
+                                threads_option)
+
+INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
+
+
+def track(
+    input: str = input_argument(INPUT_HELP),
+    json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (see docs/contract.md)."),
+    csv: Optional[Path] = typer.Option(None, "--csv", help="Write the tracks' samples as CSV (track,t,x,sigma[,x_m]); "
+                                       "'-' prints them on stdout."),
+    png: Optional[Path] = typer.Option(None, "--png", help="Draw the tracks over the horizontal space-time plot "
+                                       "(for a video, averaged down to at most 2048 time columns). " + PNG_NAME),
+    view_width: Optional[float] = number_option(None, "--view-width", lo=0, hi=1e4, lo_open=True,
+                                                help="The view's width on the wall at its mid-height, in metres: "
+                                                     "adds x_m (metres from the view's centre) to every sample."),
+    roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
+    force: bool = typer.Option(False, "--force", help=force_help("the --csv and --png files")),
+    strict: bool = strict_option(),
+    threads: int = threads_option("Decoder threads (0: FFmpeg chooses)."),
+    stream: Optional[int] = stream_option(),
+    stall_timeout: Optional[float] = stall_option(),
+) -> None:
+    """Track each moving person along the wall: where their shade falls, over time.
+
+    A person out of view shades part of the wall from the room's light; as they walk, the
+    shade travels and draws a dark streak in the horizontal space-time plot. track follows
+    the streaks: each track is a list of samples (10 a second) with t (seconds from the first
+    frame), x (a fraction of the view's width: 0 = the view's left edge, 1 = its right edge)
+    and sigma (its uncertainty, same unit). A person moving in place (crouching, waving,
+    jumping) is a track whose x stays. A clip where nobody moves has no tracks, and says so.
+
+    x is where the shade is, which the light's direction sets: it can lead or trail the
+    person, and a window beside the wall mirrors it. On the rendered recordings'
+    motion-capture truth the longest track of a single walker follows the person (Pearson
+    r >= 0.8) on about half the clips; see research/track/README.md before reading x as a
+    person's place.
+
+    \b
+    Examples:
+      wallcli track clip.mp4
+      wallcli track clip.mp4 --json | jq '.tracks | length'
+      wallcli track clip.mp4 --png tracks.png --csv tracks.csv
+      wallcli track plots.npz --view-width 2.3 --csv -
+    """
+    from wallcli.cli.common import use_stream
+    from wallcli.errors import UsageError
+
+    use_stream(stream, stall_timeout)
+    roi_t = parse_roi(roi)
+    if json_out and csv is not None and str(csv) == "-":
+        raise UsageError("--json and --csv - both print on stdout: give --csv a file name")
+    check_png_names(("--png", png))
+    from wallcli.io.writer import check_outputs, committed_together
+
+    files = [p for p in (csv, png) if p is not None and str(p) != "-"]
+    check_outputs(files, force=force, inputs=[input])
+    from wallcli.cli.output import progress, wrote
+    from wallcli.infer.track import track_plot, track_video
+
+    if str(input).lower().endswith(".npz"):
+        from wallcli.infer.classify import load_plot
+
+        plot = load_plot(input, roi=roi_t)
+        result, st = track_plot(plot, str(input), view_width=view_width)
+    else:
+        with progress("track", None) as advance:
+            result, st = track_video(input, roi=roi_t, threads=threads, progress=advance, keep_plot=png is not None,
+                                     view_width=view_width, corrections=corrections_of(False, False, False))
+    if strict:
+        refuse_view(input, result.get("view"))
+    with committed_together():
+        _report(result, st, json_out=json_out, csv=csv, png=png, force=force)
+    wrote((csv if csv is not None and str(csv) != "-" else None, "the tracks' samples"),
+          (png, "the tracks over the horizontal plot"))
+
+
+def _report(result, st, *, json_out: bool, csv, png, force: bool) -> None:
+    from wallcli.cli.output import emit_json, print_table, log
+    from wallcli.infer.track import track_csv
+
+    if png is not None:
+        from wallcli.plots.track import save_track_png
+
+        save_track_png(png, st, result, force=force)
+    if csv is not None:
+        text = track_csv(result)
+        if str(csv) == "-":
+            import sys
+
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        else:
+            from wallcli.io.writer import write_text_atomic
+
+            write_text_atomic(csv, text, force=force)
+    if json_out:
+        emit_json(result)
+        return
+    if csv is not None and str(csv) == "-":
+        return
+    tracks = result["tracks"]
+    if not tracks:
+        log(f"{result['input']}: no tracks: {result['reason']}")
+        return
+    rows = []
+    for tr in tracks:
+        xs = [s["x"] for s in tr["samples"]]
+        rows.append([tr["id"], f"{tr['start']:.1f}", f"{tr['end']:.1f}", f"{xs[0]:.2f}", f"{xs[-1]:.2f}",
+                     f"{min(xs):.2f}-{max(xs):.2f}", "moves" if tr["moving"] else "stays", f"{tr['strength']:.1f}"])
+    print_table(f"{result['input']}: {len(tracks)} track{'s' if len(tracks) != 1 else ''}",
+                ["track", "from (s)", "to (s)", "x first", "x last", "x range", "", "strength"], rows)
+    sim = result["simultaneous"]
+    if sim["seconds"]:
+        log(f"two tracks at once, apart, for {sim['seconds']:.1f} s")
+    if result.get("reason"):
+        log(result["reason"])

@@ -1,0 +1,86 @@
+"""``wallcli track``'s analysis: a clip's tracks from the same decode and camera pipeline as count.
+
+The rows are count's (io.video -> camera pipeline -> view check -> rows at 30 fps, 64 bins); only
+the horizontal ones are read, and a :class:`~wallcli.signal.track.TrackBuilder` keeps one chunk of
+them, so memory does not grow with the clip's length. A .npz from ``wallcli stplot`` is tracked at
+its own rate.
+"""
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from wallcli.camera import corrections as corr
+from wallcli.signal.track import GEOMETRY_SIGMA, TrackBuilder, simultaneous, track_rows
+
+BINS, FPS = 64, 30.0
+# what _Decode needs of a model: the rows' shape and rate (the tracker reads no net)
+_ROWS = SimpleNamespace(bins=BINS, fps=FPS, window=256, input_names=["horizontal"])
+MIN_SAMPLES = 60  # 2 s at 30 fps: a track lasts at least a second, and the background needs more
+NONE_MOVES = "no moving person's shade on the wall: nobody moves, or too faintly to follow"
+
+
+def _result(source: str, tracks, *, fps: float, view_width: float | None, extra: dict) -> dict[str, Any]:
+    out = {"input": source, "task": "track", "fps": fps,
+           "method": {"name": "wallcli-streaks", "unit": "fraction of the view's width at its mid-height",
+                      "geometry_sigma": GEOMETRY_SIGMA},
+           "tracks": [t.as_dict(view_width) for t in tracks],
+           "simultaneous": simultaneous(tracks)}
+    if view_width is not None:
+        out["view_width_m"] = view_width
+    out["reason"] = None if tracks else NONE_MOVES
+    out.update(extra)
+    return out
+
+
+def track_plot(plot, source: str, *, view_width: float | None = None):
+    """(result, plot) for a .npz space-time plot (already in memory)."""
+    rows = np.moveaxis(plot.horizontal, 0, 1)  # (T, bins, 3)
+    t = np.asarray(plot.time, np.float64)
+    fps = float((len(t) - 1) / (t[-1] - t[0])) if len(t) > 1 and t[-1] > t[0] else FPS
+    extra = {}
+    if isinstance((plot.meta or {}).get("view"), dict):
+        extra["view"] = plot.meta["view"]
+    return _result(source, track_rows(rows, t, fps), fps=round(fps, 3), view_width=view_width, extra=extra), plot
+
+
+def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_plot: bool = False,
+                view_width: float | None = None, corrections: corr.Options = corr.Options()):
+    """(result, plot) for a video, decoded once; ``plot`` is a bounded thumbnail for drawing (or None)."""
+    from wallcli.infer.classify import _Decode
+    from wallcli.infer.stream import PlotThumbnail
+    from wallcli.io.video import open_video
+
+    builder = TrackBuilder(FPS)
+    thumb = PlotThumbnail() if keep_plot else None
+    with open_video(source, threads=threads) as reader:
+        with _Decode(_ROWS, reader, roi=roi, corrections=corrections, progress=progress, ahead=True) as decode:
+            rows = decode.rows
+            for t, row in rows:
+                builder.push(t, row[:BINS])
+                if thumb is not None:
+                    thumb.push(t, row)
+        decode.check.fps = float(reader.info.fps or 0.0) or None
+    if builder.samples < MIN_SAMPLES:
+        from wallcli.errors import WallcliError
+
+        raise WallcliError(f"{source} is too short: {decode.unique.decoded} frame(s) decoded; tracking needs "
+                           f"{MIN_SAMPLES / FPS:g} s")
+    view = decode.check.summary()
+    extra = {"view": view, "corrections": decode.unique.corrections(), "duration": round(builder.samples / FPS, 3)}
+    result = _result(str(source), builder.finish(), fps=FPS, view_width=view_width, extra=extra)
+    if not view.get("usable", True):
+        result["reason"] = f"view not usable: {view.get('reason')}"
+    return result, (thumb.plot(rows, BINS, FPS) if thumb is not None else None)
+
+
+def track_csv(result: dict) -> str:
+    """One row per track sample: track,t,x,sigma[,x_m]."""
+    metres = "view_width_m" in result
+    lines = ["track,t,x,sigma" + (",x_m" if metres else "")]
+    for tr in result["tracks"]:
+        for s in tr["samples"]:
+            lines.append(f"{tr['id']},{s['t']},{s['x']},{s['sigma']}" + (f",{s['x_m']}" if metres else ""))
+    return "\n".join(lines) + "\n"
