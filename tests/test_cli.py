@@ -7,7 +7,7 @@ import pytest
 
 from wallcli import __version__
 
-COMMANDS = ["stplot", "amplify", "snr", "count", "activity", "simulate", "train", "evaluate", "report", "scan"]
+COMMANDS = ["stplot", "amplify", "snr", "count", "activity", "track", "simulate", "train", "evaluate", "report", "scan"]
 
 
 def test_version_and_module_entry_point():

@@ -59,7 +59,9 @@ class Track:
             if view_width is not None:
                 d["x_m"] = round(float((x - 0.5) * view_width), 4)
             samples.append(d)
-        moved = float(np.ptp(self.x)) if self.x else 0.0
+        # most of a walker's samples spread over the wall; a person in place stays, while the path
+        # may stray where their shade fades between movements
+        moved = float(np.subtract(*np.percentile(self.x, [90, 10]))) if self.x else 0.0
         return {"id": self.id, "start": round(float(self.t[0]), 3), "end": round(float(self.t[-1]), 3),
                 "moving": moved >= 0.25, "strength": round(float(np.median(self.strength)), 2), "samples": samples}
 
@@ -175,8 +177,14 @@ def chunk_segments(rows: np.ndarray, times: np.ndarray, fps: float) -> list[dict
             if (b - a) / fps < MIN_SECONDS:
                 continue
             p = path[a:b]
+            x = (p + 0.5) / B
             w = np.array([_width(dark[a + i], int(p[i])) for i in range(b - a)]) / B
-            out.append({"t": times[a:b], "x": (p + 0.5) / B, "sigma": np.sqrt(w ** 2 + GEOMETRY_SIGMA ** 2),
+            seen = held[a:b] >= floor
+            if not seen.all():  # across a short fade the path strays: the place is drawn between its ends
+                i = np.arange(b - a)
+                x = np.interp(i, i[seen], x[seen])
+                w = np.where(seen, w, np.maximum(w, np.abs(np.interp(i, i[seen], x[seen]) - (p + 0.5) / B)))
+            out.append({"t": times[a:b], "x": x, "sigma": np.sqrt(w ** 2 + GEOMETRY_SIGMA ** 2),
                         "strength": held[a:b]})
         for t in range(T):  # the next path keeps off this one's whole dip (a broad shade is one person)
             g = max(guard, int(np.ceil(2.0 * _width(dark[t], int(path[t])))))
