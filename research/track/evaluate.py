@@ -5,7 +5,8 @@ windows, research/track/data.py), and for single walkers the issue's two figures
 track: Pearson r of its x with the true x at the same times, and its median absolute error (view
 widths). Two-person evidence (``simultaneous``) is printed by class and band. The tracker has no
 parameter fitted on the recordings except GEOMETRY_SIGMA, so its figures are out of fold as they
-stand; ``--fit-sigma`` prints that constant's estimate fold by fold (each from the other folds).
+stand, except MAX_SPEED (research/track/tune.py) and GEOMETRY_SIGMA, whose fold-by-fold estimate (each
+from the other folds) and out-of-fold coverage this prints.
 
     python research/track/evaluate.py [--json runs/track_eval.json]
 """
@@ -32,7 +33,9 @@ def walker_figures(c, tracks):
     xt = np.interp(t, np.arange(c.x.shape[1]) / FPS, c.x[0])
     xe = np.asarray(tr.x)
     r = float(np.corrcoef(xe, xt)[0, 1]) if len(t) > 2 and np.std(xe) > 0 and np.std(xt) > 0 else 0.0
-    return {"r": r, "err": float(np.median(np.abs(xe - xt))), "seconds": float(tr.duration), "n_tracks": len(tracks)}
+    sg = np.asarray(tr.sigma)
+    return {"r": r, "err": float(np.median(np.abs(xe - xt))), "seconds": float(tr.duration), "n_tracks": len(tracks),
+            "within_sigma": float(np.mean(np.abs(xe - xt) <= sg)), "abs_err": np.abs(xe - xt).tolist()}
 
 
 def main() -> None:
@@ -55,6 +58,22 @@ def main() -> None:
     print(f"single walkers, detectable: {len(W)}; r >= 0.8 on {int((rs >= 0.8).sum())} "
           f"({(rs >= 0.8).mean():.0%}); median error <= 0.25 on {int((es <= 0.25).sum())} ({(es <= 0.25).mean():.0%}); "
           f"|r| >= 0.8 on {int((np.abs(rs) >= 0.8).sum())}")
+    follows = [r for r in W if r["walker"] and r["walker"]["r"] >= 0.8]
+    if follows:
+        errs = np.concatenate([r["walker"]["abs_err"] for r in follows])
+        cover = np.mean([r["walker"]["within_sigma"] for r in follows])
+        print(f"walkers whose track follows them (r >= 0.8): 1.4826 x median |error| = {1.4826 * np.median(errs):.3f} "
+              f"of the width; samples within their sigma: {cover:.0%} (68 % for a calibrated Gaussian)")
+    # GEOMETRY_SIGMA: the 68th percentile of |error| over the other folds' walkers, and how often it covers
+    with_w = [r for r in W if r["walker"]]
+    got, n, fold_s = 0, 0, []
+    for k in range(5):
+        s = float(np.percentile(np.concatenate([r["walker"]["abs_err"] for r in with_w if r["fold"] != k]), 68))
+        e = np.concatenate([r["walker"]["abs_err"] for r in with_w if r["fold"] == k])
+        got, n = got + int(np.sum(e <= s)), n + len(e)
+        fold_s.append(round(s, 3))
+    print(f"geometry sigma by fold (68th percentile of |error|, other folds): {fold_s}; "
+          f"out of fold it covers {got / n:.0%} of {n} samples")
     for r in W:
         w = r["walker"] or {}
         print(f"  {r['file']:22s} {r['band']:5s} r={w.get('r', float('nan')):+.2f} err={w.get('err', float('nan')):.2f} "

@@ -25,7 +25,7 @@ CHUNK_SECONDS = 16.0  # the median background is taken over a chunk this long
 OVERLAP_SECONDS = 4.0  # chunks overlap by this much, so a track is linked across them
 SMOOTH_SECONDS = 0.1  # time smoothing of the darkness map (a walker's shade lasts ~0.5 s on a bin)
 SMOOTH_BINS = 1.5  # of 64 bins; scaled with the plot's bins
-MAX_SPEED = 1.0  # view widths per second a streak moves without penalty (a walker's shade: 0.3-0.9)
+MAX_SPEED = 0.5  # view widths a second a streak moves without penalty (chosen out of fold: research/track/tune.py)
 MAX_PATHS = 3
 GUARD = 0.1  # of the width: the next path keeps this far from the ones found
 THRESHOLD = 6.0  # darkness, in units of the noise left after smoothing, that holds a track (empty rooms: 95 % under it)
@@ -34,10 +34,11 @@ BRIDGE_SECONDS = 1.5  # a path's runs this close are one track (a shade fades as
 MIN_SECONDS = 1.0  # shorter runs over the threshold are not tracks
 OUT_HZ = 10.0  # samples per second in a track
 LINK_WIDTH = 0.12  # of the width: two tracks meeting at a chunk boundary are one when this close
-# The spread of the streak's place about the person's (view widths), out of fold on the rendered
-# recordings' walkers whose streak follows them (research/track/README.md: 1.4826 x the median
-# absolute error). It is the floor of every sample's sigma.
-GEOMETRY_SIGMA = 0.15
+# How far the streak's place is from the person's (view widths): the 68th percentile of the error on
+# the rendered recordings' single walkers, 0.34-0.55 fold by fold, covering 66 % out of fold
+# (research/track/README.md). A shade falls where the light puts it, so this is large; it is the
+# floor of every sample's sigma.
+GEOMETRY_SIGMA = 0.45
 
 
 @dataclass
