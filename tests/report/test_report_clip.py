@@ -12,7 +12,7 @@ from clips import write_clip
 from report_clips import FRAMES, HOSTILE, run_main, wall_frame
 from pagetree import parse, table_rows
 
-SECTIONS = ("evidence", "frame", "snr", "plots", "count", "activity", "models", "method", "limits")
+SECTIONS = ("evidence", "frame", "snr", "plots", "tracks", "count", "activity", "models", "method", "limits")
 
 
 def _facts(page) -> dict[str, str]:
@@ -42,7 +42,7 @@ def test_every_section_is_there_and_self_contained(clip_report):
     csp = page.find_all("meta", http_equiv="Content-Security-Policy")[0].attrs["content"]
     assert "default-src 'none'" in csp and "img-src data:" in csp and "script-src 'none'" in csp
     imgs = page.find_all("img")
-    assert len(imgs) == 5  # frame, heatmap, plots, two timelines
+    assert len(imgs) == 6  # frame, heatmap, plots, tracks, two timelines
     for img in imgs:
         w, h = _png_size(img.attrs["src"])
         assert w > 200 and h > 100

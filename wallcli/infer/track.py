@@ -22,7 +22,8 @@ MIN_SAMPLES = 60  # 2 s at 30 fps: a track lasts at least a second, and the back
 NONE_MOVES = "no moving person's shade on the wall: nobody moves, or too faintly to follow"
 
 
-def _result(source: str, tracks, *, fps: float, view_width: float | None, extra: dict) -> dict[str, Any]:
+def track_result(source: str, tracks, *, fps: float, view_width: float | None = None, extra: dict | None = None) -> dict[str, Any]:
+    """The ``wallcli track --json`` object of ``tracks`` (docs/contract.md)."""
     out = {"input": source, "task": "track", "fps": fps,
            "method": {"name": "wallcli-streaks", "unit": "fraction of the view's width at its mid-height",
                       "geometry_sigma": GEOMETRY_SIGMA},
@@ -31,7 +32,7 @@ def _result(source: str, tracks, *, fps: float, view_width: float | None, extra:
     if view_width is not None:
         out["view_width_m"] = view_width
     out["reason"] = None if tracks else NONE_MOVES
-    out.update(extra)
+    out.update(extra or {})
     return out
 
 
@@ -43,7 +44,7 @@ def track_plot(plot, source: str, *, view_width: float | None = None):
     extra = {}
     if isinstance((plot.meta or {}).get("view"), dict):
         extra["view"] = plot.meta["view"]
-    return _result(source, track_rows(rows, t, fps), fps=round(fps, 3), view_width=view_width, extra=extra), plot
+    return track_result(source, track_rows(rows, t, fps), fps=round(fps, 3), view_width=view_width, extra=extra), plot
 
 
 def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_plot: bool = False,
@@ -70,7 +71,7 @@ def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_
                            f"{MIN_SAMPLES / FPS:g} s")
     view = decode.check.summary()
     extra = {"view": view, "corrections": decode.unique.corrections(), "duration": round(builder.samples / FPS, 3)}
-    result = _result(str(source), builder.finish(), fps=FPS, view_width=view_width, extra=extra)
+    result = track_result(str(source), builder.finish(), fps=FPS, view_width=view_width, extra=extra)
     if not view.get("usable", True):
         result["reason"] = f"view not usable: {view.get('reason')}"
     return result, (thumb.plot(rows, BINS, FPS) if thumb is not None else None)

@@ -44,6 +44,7 @@ class ClipAnalysis:
     view: dict[str, Any] = field(default_factory=dict)  # the view check's verdict on the clip
     options: Any = None  # the corrections asked for (wallcli.camera.corrections.Options)
     snr_corrections: list = field(default_factory=list)  # what the SNR estimator's corrections found
+    tracks: dict[str, Any] | None = None  # wallcli track's result on the same rows
 
 
 class _Tee:
@@ -153,6 +154,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     options = corrections if corrections is not None else Options()
     facts = file_facts(source)
     thumb = PlotThumbnail(PLOT_COLUMNS)
+    from wallcli.signal.track import TrackBuilder
+
     with warnings.catch_warnings(record=True) as caught, open_video(source, threads=threads) as reader:
         warnings.simplefilter("always")
         info = reader.info
@@ -162,8 +165,10 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         first = models["count"]
         rows = RowStream(tee, roi=roi, bins=first.bins, fps=first.fps, progress=progress, vertical=True,
                          register=options.shake)
+        tracker = TrackBuilder(first.fps)
         for t, row in rows:
             thumb.push(t, row)
+            tracker.push(t, row[:first.bins])
             row = stream_row(row, rows)
             for c in classifiers.values():
                 c.push(t, row, rows.ref)
@@ -205,6 +210,10 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
                        warnings=notes, view=tee.view.summary(),
                        options=corrections if corrections is not None else Options(),
                        snr_corrections=list(tee.snr.corrections))
+    from wallcli.infer.track import MIN_SAMPLES, track_result
+
+    if tracker.samples >= MIN_SAMPLES:
+        out.tracks = track_result(str(source), tracker.finish(), fps=float(first.fps))
     for task, c in classifiers.items():
         try:
             out.results[task] = bound_result(with_view(c.result(str(source), frames=rows.frames), tee.view),

@@ -41,6 +41,10 @@ def clip_figures(a) -> dict[str, str]:
         draw("frame", save_frame_png, a.frame, a.roi, title=f"{label}: first decoded frame")
         draw("heatmap", save_heatmap_png, a.grid, of="snr", title=label)
         draw("stplot", save_stplot_png, plot)
+        if a.tracks is not None:
+            from wallcli.plots.track import save_track_png
+
+            draw("tracks", save_track_png, plot, dict(a.tracks, input=label))
         for task, result in a.results.items():
             draw(f"timeline_{task}", save_timeline_png, dict(result, input=label), plot)
     return out

@@ -78,7 +78,7 @@ def clip_page(a, *, command: str) -> str:
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
         plot={"bins": a.plot.bins, "frames": a.identity["frames"]},
         figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],
-        corrections=corrections_view(a), view=a.view,
+        corrections=corrections_view(a), view=a.view, tracks=a.tracks,
     )
 
 
