@@ -58,12 +58,13 @@ def outputs(tmp_path_factory):
     out = {"simulate": json.loads(clip.with_suffix(".json").read_text())}
     for cmd in ("count", "activity", "snr"):
         out[cmd] = json.loads(run(cmd, clip, "--json"))
+    out["track"] = json.loads(run("track", clip, "--json", "--view-width", "2.2"))
     out["scan"] = scan_video(str(clip), ScanConfig(tasks=("count", "activity", "snr")))
     return out
 
 
 SECTIONS = {"count": "`wallcli count INPUT --json`", "activity": "`wallcli activity INPUT --json`",
-            "snr": "`wallcli snr INPUT --json`", "simulate": "`wallcli simulate ... -o OUT`",
+            "snr": "`wallcli snr INPUT --json`", "track": "`wallcli track INPUT --json`", "simulate": "`wallcli simulate ... -o OUT`",
             "scan": "`wallcli scan INPUT... -o results.jsonl`",
             # count's own section, which activity ("As count") does not inherit
             "count_stages": "`wallcli count INPUT --json`: the two stages"}

@@ -182,3 +182,27 @@ def test_cli_reads_a_plot_file_and_refuses_bad_input(walker_clip, run_cli, tmp_p
     assert code == 1 and err.startswith("Error:")
     code, out, err = run_cli("track", str(clip), "--json", "--csv", "-")
     assert code == 2
+
+
+def test_follow_prints_samples_as_chunks_complete_and_ends_with_the_whole_result(tmp_path, run_cli):
+    from wallcli.cli.app import main
+
+    clip = tmp_path / "long.mp4"
+    with pytest.raises(SystemExit):
+        main(["simulate", "-o", str(clip), "--people", "1", "--activity", "walking", "--seed", "8", "--size", "96x72",
+              "--duration", "30"])
+    code, out, err = run_cli("track", str(clip), "--follow", "--idle-timeout", "0")
+    assert code == 0, err
+    lines = [json.loads(x) for x in out.splitlines()]
+    assert lines[-1]["task"] == "track"
+    updates = lines[:-1]
+    assert len(updates) >= 2  # a 30 s clip is read in more than one chunk
+    code, out, _ = run_cli("track", str(clip), "--json")
+    whole = json.loads(out)
+    assert lines[-1]["tracks"] == whole["tracks"]
+    # the lines, joined per track, are the whole result's samples, each once
+    for k in whole["tracks"]:
+        joined = [s for u in updates if u["id"] == k["id"] for s in u["samples"]]
+        assert joined == k["samples"]
+    code, out, err = run_cli("track", str(clip), "--follow", "--png", str(tmp_path / "x.png"))
+    assert code == 2 and out == ""

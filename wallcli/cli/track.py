@@ -26,6 +26,11 @@ def track(
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
     force: bool = typer.Option(False, "--force", help=force_help("the --csv and --png files")),
     strict: bool = strict_option(),
+    follow: bool = typer.Option(False, "--follow", help="Live or growing input: print each track's new samples as "
+                                "JSON Lines as soon as they are found (every 12 s of video), then the whole result."),
+    idle_timeout: float = number_option(5.0, "--idle-timeout", lo=0, hi=1e6,
+                                        help="With --follow on a file: keep reading it as a recorder writes it, "
+                                             "and end when it has not grown for this many seconds."),
     threads: int = threads_option("Decoder threads (0: FFmpeg chooses)."),
     stream: Optional[int] = stream_option(),
     stall_timeout: Optional[float] = stall_option(),
@@ -51,12 +56,29 @@ def track(
       wallcli track clip.mp4 --json | jq '.tracks | length'
       wallcli track clip.mp4 --png tracks.png --csv tracks.csv
       wallcli track plots.npz --view-width 2.3 --csv -
+      ffmpeg -i rtsp://cam/stream -c copy -f nut - | wallcli track - --follow
     """
     from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 
-    use_stream(stream, stall_timeout)
+    use_stream(stream, stall_timeout, live=follow)
     roi_t = parse_roi(roi)
+    if follow:
+        if csv is not None or png is not None:
+            raise UsageError("--csv and --png need the whole clip; they cannot be combined with --follow")
+        if str(input).lower().endswith(".npz"):
+            raise UsageError("--follow reads live video; a .npz space-time plot is already complete")
+        from wallcli.cli.output import emit_json
+        from wallcli.infer.track import follow_tracks
+        from wallcli.io.video import FOLLOW_IDLE
+
+        FOLLOW_IDLE.set(float(idle_timeout))
+        for rec in follow_tracks(input, roi=roi_t, threads=threads, view_width=view_width,
+                                 corrections=corrections_of(False, False, False)):
+            if strict and "view" in rec:
+                refuse_view(input, rec.get("view"))
+            emit_json(rec)
+        return
     if json_out and csv is not None and str(csv) == "-":
         raise UsageError("--json and --csv - both print on stdout: give --csv a file name")
     check_png_names(("--png", png))

@@ -85,3 +85,43 @@ def track_csv(result: dict) -> str:
         for s in tr["samples"]:
             lines.append(f"{tr['id']},{s['t']},{s['x']},{s['sigma']}" + (f",{s['x_m']}" if metres else ""))
     return "\n".join(lines) + "\n"
+
+
+def follow_tracks(source: str, *, roi=None, threads: int = 0, view_width: float | None = None,
+                  corrections: corr.Options = corr.Options()):
+    """``--follow``: each track's new samples as soon as a chunk of rows is read (one object per track
+    and chunk: ``{"id", "samples"}``), then the whole clip's result (the object of ``--json``)."""
+    from wallcli.errors import WallcliError
+    from wallcli.infer.classify import _Decode
+    from wallcli.io.video import open_video
+
+    builder = TrackBuilder(FPS)
+    said: dict[int, int] = {}
+
+    def news():
+        for k in builder.tracks:
+            n = said.get(k.id, 0)
+            if len(k.t) > n:
+                d = k.as_dict(view_width)
+                said[k.id] = len(k.t)
+                yield {"id": k.id, "samples": d["samples"][n:]}
+
+    with open_video(source, threads=threads) as reader:
+        decode = _Decode(_ROWS, reader, roi=roi, corrections=corrections)
+        for t, row in decode.rows:
+            n = len(builder.tracks), sum(len(k.t) for k in builder.tracks)
+            builder.push(t, row[:BINS])
+            if (len(builder.tracks), sum(len(k.t) for k in builder.tracks)) != n:
+                yield from news()
+    if builder.samples < MIN_SAMPLES:
+        raise WallcliError(f"{source} is too short: {decode.unique.decoded} frame(s) decoded; tracking needs "
+                           f"{MIN_SAMPLES / FPS:g} s")
+    tracks = builder.finish()
+    yield from news()
+    view = decode.check.summary()
+    result = track_result(str(source), tracks, fps=FPS, view_width=view_width,
+                          extra={"view": view, "corrections": decode.unique.corrections(),
+                                 "duration": round(builder.samples / FPS, 3)})
+    if not view.get("usable", True):
+        result["reason"] = f"view not usable: {view.get('reason')}"
+    yield result
