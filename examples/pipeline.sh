@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Set up wallcli (once, into .venv) and run the main job on a bundled example clip:
-# how strong is the signal, the space-time plots, how many people, what they do, and the
-# amplified video. Outputs go to out/ at the top of the checkout (git-ignored): outside
-# examples/, so that `wallcli scan examples` finds the bundled clips only, not this script's
+# how strong is the signal, the space-time plots, how many people, what they do, where along
+# the wall, and the amplified video. Outputs go to out/ at the top of the checkout (git-ignored):
+# outside examples/, so that `wallcli scan examples` finds the bundled clips only, not this script's
 # amplified video (which is no wall).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,5 +26,7 @@ echo "== how many people (from the plots)" >&2
 $w count "$out/plots.npz"
 echo "== what they are doing" >&2
 $w activity "$clip"
+echo "== where along the wall (tracks of the shades) -> $out/tracks.png" >&2
+$w track "$clip" --png "$out/tracks.png" --force
 echo "== amplified video -> $out/amplified.mp4" >&2
 $w amplify "$clip" "$out/amplified.mp4" --side-by-side --force

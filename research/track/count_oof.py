@@ -49,7 +49,16 @@ def main() -> None:
     ap.add_argument("--lam", type=float, default=1.0)
     a = ap.parse_args()
     names = a.features.split(",")
-    F = json.loads((ROOT / "runs" / "twofeat.json").read_text())
+    path = ROOT / "runs" / "twofeat.json"
+    if not path.is_file():  # every recording's features (truth is not needed), once
+        sys.path.insert(0, str(HERE))
+        from data import full_plot
+        from twofeat import features
+
+        path.write_text(json.dumps({r.name: features(full_plot(r.horizontal, r.h_offset, r.starts, r.frames),
+                                                     full_plot(r.vertical, r.v_offset, r.starts, r.frames), 30.0)
+                                    for r in recordings()}))
+    F = json.loads(path.read_text())
     B = json.loads((ROOT / "runs" / "baseline_probs.json").read_text())
     recs = recordings()
     base = np.array([B[r.name]["count"] for r in recs])
