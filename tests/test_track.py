@@ -206,3 +206,19 @@ def test_follow_prints_samples_as_chunks_complete_and_ends_with_the_whole_result
         assert joined == k["samples"]
     code, out, err = run_cli("track", str(clip), "--follow", "--png", str(tmp_path / "x.png"))
     assert code == 2 and out == ""
+
+
+def test_a_region_narrower_than_the_bins_reads_no_infinite_darkness(walker_clip, run_cli, tmp_path):
+    # a 4x4 region repeats each pixel over 16 bins: nothing changes bin by bin, so the noise is read
+    # on the map's own spread (it once read 1e-12, and every wobble was a track of strength 2e11)
+    code, out, err = run_cli("track", str(walker_clip), "--roi", "0,0,4,4", "--json")
+    assert code == 0, err
+    assert all(k["strength"] < 1e3 for k in json.loads(out)["tracks"])
+
+
+def test_a_plot_file_under_two_seconds_is_too_short(tmp_path, run_cli):
+    from tests.clips import write_plot
+
+    short = write_plot(tmp_path / "short.npz", seconds=1.0)
+    code, out, err = run_cli("track", str(short))
+    assert code == 1 and "too short" in err and out == ""

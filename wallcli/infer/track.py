@@ -40,6 +40,11 @@ def track_plot(plot, source: str, *, view_width: float | None = None):
     """(result, plot) for a .npz space-time plot (already in memory)."""
     rows = np.moveaxis(plot.horizontal, 0, 1)  # (T, bins, 3)
     t = np.asarray(plot.time, np.float64)
+    if len(t) < 2 or t[-1] - t[0] < (MIN_SAMPLES - 1) / FPS:
+        from wallcli.errors import WallcliError
+
+        span = f"{t[-1] - t[0]:.2f} s" if len(t) else "no samples"
+        raise WallcliError(f"{source} is too short: {len(t)} sample(s), {span}; tracking needs {MIN_SAMPLES / FPS:g} s")
     fps = float((len(t) - 1) / (t[-1] - t[0])) if len(t) > 1 and t[-1] > t[0] else FPS
     extra = {}
     if isinstance((plot.meta or {}).get("view"), dict):

@@ -100,6 +100,9 @@ def darkness(rows: np.ndarray, fps: float) -> np.ndarray:
     fine = 1.4826 * np.median(np.abs(d - ds))
     g = _gain(sb)
     noise = fine * np.sqrt(g / max(1.0 - g, 1e-6))
+    spread = 1.4826 * np.median(np.abs(ds - np.median(ds)))
+    if noise <= 1e-3 * spread:  # bins that repeat pixels (a region narrower than the bins): no fine part to read
+        noise = spread
     return -ds / max(noise, 1e-12)
 
 
