@@ -50,6 +50,7 @@ BASES = {
     "snr": [["{clip}", "--json"], ["--predict", "--json"]],
     "count": [["{plot}", "--json", "--plot", "out.png"], ["{clip}"]],
     "activity": [["{plot}", "--json"], ["{clip}"]],
+    "track": [["{plot}", "--json", "--csv", "out.csv", "--png", "out.png"], ["{clip}"]],
     "simulate": [["-o", "out.y4m", "--size", "16x16", "--duration", "0.2", "--fps", "15", "--grid", "4x4"]],
     "train": [["count", "--data", "nodata", "--out", "out.onnx"]],
     "evaluate": [["{labelled}", "--task", "count", "--json", "--jobs", "1"]],
