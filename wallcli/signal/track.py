@@ -3,14 +3,16 @@
 A person out of view darkens the part of the wall they shade from the room's light; as they walk,
 that shade travels along the wall and draws a dark streak in the horizontal space-time plot. The
 tracker reads the streaks: in chunks of the rows (so memory does not grow with the clip's length),
-each sample's profile relative to the chunk's per-position median, the whole wall's change removed
-(a light change is not a person), smoothed, in units of its own robust spread; then the best path
-through the darkness (Viterbi, with a speed limit), masked, and the next best, up to MAX_PATHS; a
-path holds a track where its darkness stays over THRESHOLD for at least MIN_SECONDS. Chunks overlap,
-and a track that ends at a chunk's end continues in the next when the two agree on the place.
+each sample's profile relative to the chunk's per-position median (a person standing still draws
+nothing), the whole wall's change removed (a light change is not a person), smoothed, in units of
+the noise that changes bin by bin; then the best path through the darkness (Viterbi, with a speed
+limit), its whole dip masked, and the next best, up to MAX_PATHS; a path holds a track where its
+darkness stays over THRESHOLD (and, for the further paths, RELATIVE of the first's) for at least
+MIN_SECONDS. Chunks overlap, and a track that ends at a chunk's end continues in the next when the
+two agree on the place.
 
 Positions are the streak's, as a fraction of the plot's width (0 = the first bin's edge, the view's
-left; 1 = the last bin's edge). A shade falls where the light's direction puts it, so the streak
+left; 1 = the last bin's edge); a shade outside the view is not seen, so x stays within 0-1. A shade falls where the light's direction puts it, so the streak
 can be offset from, or move faster than, the person, and a side window mirrors it
 (research/track/README.md measures it on the rendered recordings' motion-capture truth): ``sigma``
 is the streak's own width combined with that geometric spread, measured out of fold.
