@@ -7,7 +7,7 @@ runs/twofeat.json): fitted on four folds' clips with somebody moving, applied to
 (nobody against somebody) is left as it is. Paired with today's answers: McNemar over the detectable
 clips, and the two-person clips from 10 dB up.
 
-    python research/track/count_oof.py [--features W,Sv,...] [--c 1.0]
+    python research/track/count_oof.py [--features W,Sv,...] [--lam 1.0] [--folds fixed|balanced]
 """
 from __future__ import annotations
 
@@ -47,6 +47,8 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--features", default=DEFAULT)
     ap.add_argument("--lam", type=float, default=1.0)
+    ap.add_argument("--folds", choices=("fixed", "balanced"), default="fixed",
+                    help="fixed: the clip's number mod 5 (each fold one kind of light); balanced: (number // 5) mod 5")
     a = ap.parse_args()
     names = a.features.split(",")
     path = ROOT / "runs" / "twofeat.json"
@@ -66,7 +68,12 @@ def main() -> None:
     logodds = np.log(base[:, 2] + 1e-9) - np.log(base[:, 1] + 1e-9)
     feats = np.array([[np.log1p(max(F[r.name][n], 0.0)) for n in names] for r in recs])
     X = np.c_[logodds, feats]
-    folds = np.array([fold_of(r.name, K) for r in recs])
+    if a.folds == "fixed":
+        folds = np.array([fold_of(r.name, K) for r in recs])
+    else:
+        import re
+
+        folds = np.array([(int(re.findall(r"\d+", r.name)[0]) // 5) % K for r in recs])
     people = np.array([r.people for r in recs])
     new = lab0.copy()
     for k in range(K):
