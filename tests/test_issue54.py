@@ -44,3 +44,36 @@ def test_every_ffmpeg_pipe_line_copies_the_stream(run_cli):
              if re.search(r"ffmpeg .*-f (nut|mpegts|matroska) -", line)]
     assert len(lines) >= 4  # the README's two and count's, activity's and stplot's
     assert [(n, line) for n, line in lines if "-c copy" not in line] == []
+
+
+@pytest.mark.parametrize("k,n", [(6, 6), (0, 6), (3, 4), (1, 2), (128, 179), (47, 60)])
+def test_the_exact_interval_is_clopper_pearsons(k, n):
+    """The beta quantiles Clopper and Pearson defined, which scipy gives (a test need only)."""
+    beta = pytest.importorskip("scipy.stats").beta
+    from wallcli.evaluate.score import exact_ci
+
+    lo = 0.0 if k == 0 else beta.ppf(0.025, k, n - k + 1)
+    hi = 1.0 if k == n else beta.ppf(0.975, k + 1, n - k)
+    assert exact_ci(k, n) == pytest.approx([lo, hi], abs=1e-9)
+
+
+def _right(file, label, snr):
+    return {"file": file, "truth": label, "label": label, "confident": True, "probabilities": [0.05, 0.9, 0.05],
+            "snr_db": snr, "detectable": None, "error": None, "reason": None}
+
+
+def test_six_of_six_right_is_not_a_100_to_100_interval(capsys):
+    """evaluate's JSON and table: 6 right of 6 is 54-100 %, in the headline, decided and bands."""
+    from wallcli.cli._evaluate_table import print_evaluation
+    from wallcli.evaluate.run import report
+
+    rows = [_right(f"{i}.mp4", 1, 3.0 + i) for i in range(6)]
+    res = report(rows, task="count", model={"name": "m", "version": "1", "sha256": "0"}, classes=[0, 1, 2],
+                 folder="d", labels="labels.csv", skipped=[], stride=64, roi=None)
+    assert res["ci95"] == pytest.approx([0.025 ** (1 / 6), 1.0])
+    assert res["ci95_decided"] == res["ci95"] and res["interval"]["method"] == "clopper-pearson"
+    one = next(c for c in res["per_class"] if c["class"] == 1)
+    assert one["ci95"] == res["ci95"]
+    print_evaluation(res)
+    out = " ".join(capsys.readouterr().out.split())
+    assert "54-100 %" in out and "100-100 %" not in out

@@ -105,7 +105,7 @@ def _summary(res: dict, show_det: bool) -> None:
         ("right of decided", lambda b: _of(b["correct_decided"], b["decided"], 1)),
         ("errors", lambda b: str(b["errors"])),
     ]
-    print_table("Summary (95 % interval: bootstrap over clips; decided: answers not undetermined)",
+    print_table("Summary (95 % interval: Clopper-Pearson; decided: not undetermined)",
                 ["clips", *blocks], [[name, *(f(b) for b in blocks.values())] for name, f in figures])
     by_reason: dict[str, int] = {}
     for s in res.get("skipped_reasons", []):

@@ -45,9 +45,9 @@ def evaluate(
     (same model, windows and stride) and its SNR measured (green channel, wallcli snr's
     estimator at the block size of one space-time plot bin). Prints first the clips right
     by SNR band (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db
-    column where there is one, else on the measured SNR), accuracy with a 95 % bootstrap
-    interval over clips, how many answers were decided (not 'undetermined') and how often
-    those were right, and the confusion matrix with accuracy per class; then one line per
+    column where there is one, else on the measured SNR), accuracy with its exact 95 %
+    interval (Clopper-Pearson, over clips), how many answers were decided (not
+    'undetermined') and how often those were right, and the confusion matrix with accuracy per class; then one line per
     clip: the answer ('?' after it when undetermined; why: --json), the truth, right or
     not, and the SNR its band is on. With a 'detectable' column, the headline figures are on
     detectable clips and the same on all clips follow; the bands count every clip. For

@@ -193,7 +193,7 @@ def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: s
         "labels": labels,
         "stride": stride,
         "roi": list(roi) if roi else None,
-        "bootstrap": {"resamples": score.BOOTSTRAP, "seed": score.SEED},
+        "interval": {"method": "clopper-pearson", "level": 0.95},
         "snr_measure": "green-channel SNR (wallcli snr's estimator) at the block size nearest one space-time "
                        "plot bin's area; see snr_block per row",
     })
