@@ -77,3 +77,18 @@ def test_six_of_six_right_is_not_a_100_to_100_interval(capsys):
     print_evaluation(res)
     out = " ".join(capsys.readouterr().out.split())
     assert "54-100 %" in out and "100-100 %" not in out
+
+
+@pytest.mark.parametrize("name", ["empty", "walking", "jumping"])
+def test_snr_verdict_text_quotes_the_figure_its_json_gives(run_cli, name):
+    """jumping.mp4's JSON gave snr_db 5.02 (at 2x2) while its text said "green 6.5 dB" (1x1)."""
+    import json
+
+    from wallcli.wording import format_db
+
+    code, out, err = run_cli("snr", ROOT / "examples" / f"{name}.mp4", "--json")
+    assert code == 0, err
+    verdict = json.loads(out)["verdict"]
+    block = verdict["block"]
+    assert f"green {format_db(verdict['snr_db'])} dB" in verdict["text"] and f"{block}x{block}" in verdict["text"]
+    assert "dB" not in verdict["text"].replace(f"{format_db(verdict['snr_db'])} dB", "")  # no other figure
