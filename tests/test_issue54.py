@@ -92,3 +92,29 @@ def test_snr_verdict_text_quotes_the_figure_its_json_gives(run_cli, name):
     block = verdict["block"]
     assert f"green {format_db(verdict['snr_db'])} dB" in verdict["text"] and f"{block}x{block}" in verdict["text"]
     assert "dB" not in verdict["text"].replace(f"{format_db(verdict['snr_db'])} dB", "")  # no other figure
+
+
+def test_the_rendered_clips_are_never_called_plain_recordings():
+    """"The recordings are 220 labelled clips of an independent path-traced renderer" read as camera
+    footage beside the report's "never from real recordings"; docs/outputs.md said 120 clips."""
+    import json
+
+    free_text = []
+    for card in ("count", "activity"):
+        def strings(x):
+            if isinstance(x, str):
+                free_text.append(x)
+            elif isinstance(x, dict):
+                [strings(v) for v in x.values()]
+            elif isinstance(x, list):
+                [strings(v) for v in x]
+        strings(json.loads((ROOT / "models" / f"{card}.json").read_text()))
+    texts = {"cards": "\n".join(free_text),
+             **{str(p.relative_to(ROOT)): p.read_text() for p in [
+                 ROOT / "README.md", ROOT / "models" / "README.md", *(ROOT / "docs").glob("*.md"),
+                 *(ROOT / "wallcli" / "report" / "templates").glob("*.j2")]}}
+    plain = re.compile(r"(?<![/`._\w-])(?:the|220|184) recordings(?![/`._\w-])|labelled recordings of", re.I)
+    said = {name: plain.findall(" ".join(text.split())) for name, text in texts.items()}
+    assert {name: found for name, found in said.items() if found} == {}
+    assert "real recordings" not in texts["wallcli/report/templates/clip.html.j2"]
+    assert "120 clips" not in texts["docs/outputs.md"] and "220" in texts["docs/outputs.md"]
