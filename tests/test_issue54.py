@@ -118,3 +118,24 @@ def test_the_rendered_clips_are_never_called_plain_recordings():
     assert {name: found for name, found in said.items() if found} == {}
     assert "real recordings" not in texts["wallcli/report/templates/clip.html.j2"]
     assert "120 clips" not in texts["docs/outputs.md"] and "220" in texts["docs/outputs.md"]
+
+
+def test_install_hints_name_what_pip_can_find(monkeypatch, run_cli, tmp_path):
+    """`pip install 'wallcli[train]'` fails (wallcli is not on the index): the error without torch,
+    train --help, simulate --help and the docs say what works: the extra's own packages (as
+    pyproject.toml lists them), or '.[extra]' from the checkout's top folder."""
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    monkeypatch.setitem(sys.modules, "torch", None)  # import torch -> ImportError, torch or not
+    code, _, err = run_cli("train", "count", "--data", tmp_path, "--out", tmp_path / "m.onnx")
+    assert code == 1 and err.startswith("Error:") and err.count("\n") == 1
+    assert "pip install torch==2.13.0 && pip install '.[train]'" in err and "checkout" in err
+    said = [err, run_cli("train", "--help")[1], run_cli("simulate", "--help")[1],
+            *(p.read_text() for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")])]
+    assert not [t for t in said if "wallcli[" in t]
+    from wallcli import extras as hints
+
+    for hint, extra in ((hints.TRAIN, "train"), (hints.ONNX, "train"), (hints.PT, "pt")):
+        assert f"'.[{extra}]'" in hint
+        named = set(re.findall(r"([a-z]+)(?:==|>=)[\d.]+", hint))
+        assert named and named <= {re.match(r"[a-z]+", d).group(0) for d in extras[extra]}
