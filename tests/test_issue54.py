@@ -181,3 +181,28 @@ def test_scans_documented_jq_lines_print_the_best_guess(tmp_path, run_cli):
             for cell, task in zip(rows[res["input"]], ("count", "activity")):
                 label = str(res[task]["label"])
                 assert cell == label if res[task]["confident"] else cell == f"undetermined, most likely {label}"
+
+
+def test_scans_csv_keeps_the_snr_verdict_and_the_views_notes(tmp_path, run_cli):
+    """The CSV's columns ended `snr.scales,view.usable,view.issues,view.reason`: the verdict line snr
+    leads with and the view's notes (crouching.mp4: a sharp shadow in view) were JSON-only."""
+    import csv
+    import json
+
+    folder = tmp_path / "clips"
+    folder.mkdir()
+    for name in ("crouching", "jumping"):
+        (folder / f"{name}.mp4").symlink_to(ROOT / "examples" / f"{name}.mp4")
+    for out in ("r.jsonl", "r.csv"):
+        code, _, err = run_cli("scan", folder, "-o", tmp_path / out, "--task", "snr", "--workers", "1")
+        assert code == 0, err
+    lines = {d["input"]: d for d in map(json.loads, (tmp_path / "r.jsonl").read_text().splitlines())}
+    rows = {r["input"]: r for r in csv.DictReader(open(tmp_path / "r.csv", newline=""))}
+    assert rows.keys() == lines.keys()
+    for name, line in lines.items():
+        row, verdict = rows[name], line["snr"]["verdict"]
+        assert row["snr.verdict.text"] == verdict["text"] and row["snr.verdict.block"] == str(verdict["block"])
+        assert row["snr.verdict.signal"] == str(verdict["signal"]).lower()
+        assert float(row["snr.verdict.snr_db"]) == pytest.approx(verdict["snr_db"])
+        assert json.loads(row["view.notes"]) == line["view"]["notes"]
+    assert any(json.loads(r["view.notes"]) for r in rows.values())  # crouching's shadow, at least
