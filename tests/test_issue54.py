@@ -206,3 +206,36 @@ def test_scans_csv_keeps_the_snr_verdict_and_the_views_notes(tmp_path, run_cli):
         assert float(row["snr.verdict.snr_db"]) == pytest.approx(verdict["snr_db"])
         assert json.loads(row["view.notes"]) == line["view"]["notes"]
     assert any(json.loads(r["view.notes"]) for r in rows.values())  # crouching's shadow, at least
+
+
+@pytest.mark.parametrize("command", ["count", "activity", "snr"])
+def test_the_terminal_says_the_views_notes_the_json_has(run_cli, command):
+    """crouching.mp4's view notes a sharp shadow ("sharp shadow or light in view ...") in the JSON and
+    the report; the terminal's table said nothing of it."""
+    import json
+
+    clip = ROOT / "examples" / "crouching.mp4"
+    code, out, err = run_cli(command, clip, "--json")
+    assert code == 0, err
+    notes = json.loads(out)["view"]["notes"]
+    assert notes and notes[0].startswith("sharp shadow or light in view")
+    code, out, err = run_cli(command, clip)
+    assert code == 0, err
+    flat = " ".join(out.split())
+    assert all(" ".join(n.split()) in flat for n in notes) and "no fault of the view" in flat
+
+
+def test_the_report_leads_its_snr_section_with_snrs_verdict(tmp_path, run_cli):
+    """`wallcli snr` leads with its verdict; the single-clip report's table had no such line."""
+    import html
+    import json
+
+    clip = ROOT / "examples" / "jumping.mp4"
+    code, out, err = run_cli("snr", clip, "--json")
+    assert code == 0, err
+    verdict = json.loads(out)["verdict"]
+    code, _, err = run_cli("report", clip, "-o", tmp_path / "r.html")
+    assert code == 0, err
+    page = (tmp_path / "r.html").read_text(encoding="utf-8")
+    said = re.search(r'<p class="verdict" id="snr-verdict">(.*?)</p>', page, re.S)
+    assert said and f"Verdict: {verdict['text']}." in html.unescape(said.group(1))
