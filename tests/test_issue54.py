@@ -239,3 +239,42 @@ def test_the_report_leads_its_snr_section_with_snrs_verdict(tmp_path, run_cli):
     page = (tmp_path / "r.html").read_text(encoding="utf-8")
     said = re.search(r'<p class="verdict" id="snr-verdict">(.*?)</p>', page, re.S)
     assert said and f"Verdict: {verdict['text']}." in html.unescape(said.group(1))
+
+
+def test_activitys_reason_is_the_one_that_decided(run_cli):
+    """crouching.mp4 (one person) said only "two people possible (p=0.05 ...)", while the card's
+    thresholds leave every answer undetermined anyway: their reason comes first, the check after."""
+    import json
+
+    from wallcli.wording import format_db
+
+    code, out, err = run_cli("activity", ROOT / "examples" / "crouching.mp4", "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    for r in [res, *res["windows"]]:
+        assert r["confident"] is False and not r["reason"].startswith("two people")
+        assert f"signal {format_db(r['signal_db'])} dB" in r["reason"] and "validation" in r["reason"]
+        assert r["reason"].endswith(f"two people possible too (p={r['two_people']:.2f} of two among people moving)")
+
+
+def test_the_two_people_check_alone_is_the_reason_where_the_card_would_decide():
+    """Where the card's thresholds would decide, the two-people check is what leaves the answer
+    undetermined, and its reason stands alone; where it passes, the card's verdict stands."""
+    from wallcli.infer.judge import _gate
+    from wallcli.infer.twostage import two_people_reason
+
+    class Gated:  # the shape of OnePersonActivity, as far as _gate reads it
+        classes = ["none", "walking"]
+
+        def __init__(self, p_two):
+            self.p_two = p_two
+
+        def gate(self, raw, label):
+            return self.p_two, (two_people_reason(self.p_two, 0.97) if self.p_two >= 0.03 else None)
+
+    probs = np.array([0.01, 0.99])
+    assert _gate(Gated(0.2), None, probs, True, None) == (False, two_people_reason(0.2, 0.97))
+    assert _gate(Gated(0.01), None, probs, True, None) == (True, None)
+    assert _gate(Gated(0.01), None, probs, False, "card's reason") == (False, "card's reason")
+    assert _gate(Gated(0.6), None, probs, False, "card's reason") == \
+        (False, "card's reason; two people likely too (p=0.60 of two among people moving)")
