@@ -278,3 +278,38 @@ def test_the_two_people_check_alone_is_the_reason_where_the_card_would_decide():
     assert _gate(Gated(0.01), None, probs, False, "card's reason") == (False, "card's reason")
     assert _gate(Gated(0.6), None, probs, False, "card's reason") == \
         (False, "card's reason; two people likely too (p=0.60 of two among people moving)")
+
+
+def test_evaluates_measured_bands_are_on_the_answers_signal(tmp_path, capsys):
+    """walking.mp4's answer says "signal -3.4 dB ... under 0 dB" while evaluate put it in "0-10 dB"
+    by the block SNR (6.8 dB): without an snr_db column the bands are on the answer's signal_db."""
+    from wallcli.cli._evaluate_table import print_evaluation
+    from wallcli.evaluate.labels import Clip
+    from wallcli.evaluate.run import _row, report
+
+    clip = Clip("walking.mp4", tmp_path / "walking.mp4", 1, "walking", None, 1)
+    answer = {"label": 1, "confident": False, "probabilities": [0.0, 1.0, 0.0], "signal_db": -3.41,
+              "reason": "'1 person' at signal -3.4 dB: ... (97 % needed; under 0 dB)"}
+    row = _row(clip, {"result": answer, "snr_db": 6.8, "snr_block": 8}, "count", has_snr=False)
+    assert (row["band"], row["signal_db"], row["snr_db"]) == ("<0 dB", -3.41, 6.8)
+    labelled = Clip("walking.mp4", tmp_path / "walking.mp4", 1, "walking", None, 1, snr_db=12.0)
+    assert _row(labelled, {"result": answer, "snr_db": 6.8}, "count", has_snr=True)["band"] == ">=10 dB"
+    res = report([row], task="count", model={"name": "m", "version": "1", "sha256": "0"}, classes=[0, 1, 2],
+                 folder="d", labels="labels.csv", skipped=[], stride=64, roi=None)
+    assert [b["clips"] for b in res["by_band"]] == [0, 1, 0, 0] and "signal_db" in res["band_measure"]
+    print_evaluation(res)
+    out = " ".join(capsys.readouterr().out.split())
+    assert "By signal band" in out and "walking.mp4 1 1 ? 100 yes -3.4" in out
+
+
+def test_amplify_names_its_own_snr(tmp_path, run_cli):
+    """amplify's snr_db is the display's blocks' SNR, a fourth figure: it is also given under a name
+    that says so, with what it measures."""
+    import json
+
+    clip = write_clip(tmp_path / "w.mkv", _wall, 90, codec="ffv1", options={})
+    code, out, err = run_cli("amplify", clip, tmp_path / "a.mp4", "--cells", "8", "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    assert res["display_snr_db"] == res["snr_db"] is not None
+    assert res["snr_measure"].startswith("display SNR") and "signal_db" in res["snr_measure"]
