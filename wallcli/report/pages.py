@@ -75,7 +75,7 @@ def clip_page(a, *, command: str) -> str:
              for t in ("count", "activity")]
     return render(
         "clip.html.j2",
-        title=a.identity["path"], command=command, roi=list(a.roi),
+        title=a.identity["path"], command=command, roi=list(a.roi), view_note=VIEW_NOTE,
         identity=dict(a.identity, container=container_name(a.identity.get("container"), a.identity.get("path"))),
         # the verdict `wallcli snr` leads with, on the page's own figures (its ROI, these rows)
         snr={"rows": rows, "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
@@ -83,7 +83,7 @@ def clip_page(a, *, command: str) -> str:
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
         plot={"bins": a.plot.bins, "frames": a.identity["frames"]},
         figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],
-        corrections=corrections_view(a), view=a.view, view_note=VIEW_NOTE,
+        corrections=corrections_view(a), view=a.view,
     )
 
 
