@@ -84,3 +84,14 @@ def decided_text(level) -> str:
     if level is None:
         return "decided"
     return f"decided: answers like this were right at least {level_text(level)} of the time in validation"
+
+
+# the report's words for a view note: a change of light on the wall is no fault of the view (the
+# contract), so the note is said beside the answers, not as a warning that they were refused
+VIEW_NOTE = "also seen, and analysed (no fault of the view)"
+
+
+def view_note_lines(view) -> list[str]:
+    """One line per note of the view check (``view.notes``), for under a terminal table."""
+    notes = view.get("notes") if isinstance(view, dict) else None
+    return [f"{VIEW_NOTE}: {n}." for n in notes or []]

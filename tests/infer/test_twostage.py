@@ -131,8 +131,9 @@ def test_the_shipped_pair_is_calibrated():
 
 def test_activity_is_not_decided_on_the_bundled_two_person_clips():
     """examples/two-walking.mp4 and two-mixed.mp4: the activity net is sure (walking, p = 1.00)
-    and its card would decide, but its answer is not defined with two people; the count net on
-    the same windows says two people are possible, so neither the clip nor any window is decided."""
+    but its answer is not defined with two people; the count net on the same windows says two
+    people are possible, so neither the clip nor any window is decided (the card's thresholds
+    would not decide them either today, and their reason comes first)."""
     from pathlib import Path
 
     from wallcli.infer.classify import classify_video
@@ -144,7 +145,8 @@ def test_activity_is_not_decided_on_the_bundled_two_person_clips():
         res, _ = classify_video(model, str(clip), stride=int(model.card["stride"]))
         assert res["label"] == "walking" and max(res["probabilities"]) > 0.99
         assert res["confident"] is False, name
-        assert "one activity is not defined" in res["reason"] and res["two_people"] >= 0.03
+        # the card's thresholds leave it undetermined anyway (issue 54): theirs first, the check after
+        assert "two people possible too" in res["reason"] and res["two_people"] >= 0.03
         assert all(w["confident"] is False and "two people" in w["reason"] for w in res["windows"])
 
 

@@ -125,7 +125,7 @@ def test_without_mitsuba_world_pt_is_one_error_naming_the_extra(tmp_path, run_cl
         code, out, err = run_cli("simulate", "--world", "pt", "--duration", "0.5", "--size", "32x24", *args)
         assert code == 1 and out == ""
         lines = err.strip().splitlines()
-        assert len(lines) == 1 and lines[0].startswith("Error:") and "wallcli[pt]" in lines[0], err
+        assert len(lines) == 1 and lines[0].startswith("Error:") and "'.[pt]'" in lines[0], err
     assert not (tmp_path / "x.mp4").exists() and not (tmp_path / "d").exists()
 
 

@@ -54,8 +54,11 @@ def csv_columns(tasks, classes: dict[str, list], windows: bool = False) -> list[
         cols += ["snr.roi", "snr.frames"]
         cols += [f"snr.{q}.{c}" for q in ("signal_power", "noise_power", "snr_db") for c in CHANNELS]
         cols += ["snr.sampled_pixels", "snr.exact", "snr.scales"]
-    # the view check's verdict, whatever the tasks (it rides on every decode)
-    return cols + ["view.usable", "view.issues", "view.reason"]
+        # the line the terminal leads with: a CSV reader should not have to re-derive it from scales
+        cols += [f"snr.verdict.{k}" for k in ("signal", "block", "snr_db", "text")]
+    # the view check's verdict, whatever the tasks (it rides on every decode); its notes (a sharp
+    # shadow in view) do not make it unusable but say what the answers were read through
+    return cols + ["view.usable", "view.issues", "view.reason", "view.notes"]
 
 
 def _cell(value: Any) -> str:

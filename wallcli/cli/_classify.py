@@ -128,7 +128,7 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
         return
     # one row per window (each lasts window/fps seconds from its start) and the clip's answer;
     # no 'end' column, and reasons under the table, so that five classes fit 80 columns
-    from wallcli.wording import answer_text, decided_text, format_db, label_text
+    from wallcli.wording import answer_text, decided_text, format_db, label_text, view_note_lines
 
     def shown(r):  # an answer that may not be relied upon is not shown as one
         return str(r["label"]) if r.get("confident", True) else "undetermined"
@@ -147,6 +147,8 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
         print_lines([f"{decided_text(level)}."])
     elif result.get("confident") is False:
         print_lines([f"undetermined: {result.get('reason') or 'no reason given'}."])
+    # what the view check saw but did not refuse (a sharp shadow in view): the JSON's view.notes
+    print_lines(view_note_lines(result.get("view")))
     if note:
         if any(not w.get("confident", True) for w in result["windows"]):
             log("Each window's reason: --json (windows[].reason).")

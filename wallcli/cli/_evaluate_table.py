@@ -27,10 +27,11 @@ def _of(k: int, n: int, digits: int = 0) -> str:
 
 
 def _snr(r: dict, labels: bool) -> str:
-    # the SNR the bands are on: labels.csv's where it has the column, else the measured one
+    # the figure the bands are on: labels.csv's SNR where it has the column, else the answer's
+    # measured signal (signal_db), the figure its reason quotes
     from wallcli.wording import format_db
 
-    value = r.get("snr_db_labels", r["snr_db"]) if labels else r["snr_db"]
+    value = r.get("snr_db_labels", r["snr_db"]) if labels else r.get("signal_db")
     return "-" if value is None else format_db(value)
 
 
@@ -39,7 +40,8 @@ def _clips(res: dict, show_det: bool) -> None:
     right or not, and the SNR its band is on. Reasons and errors are in the JSON, not here: a
     footnote a row made 265 lines of 120 clips."""
     labels = res["snr_source"] == "labels"
-    cols = ["file", "truth", "answer", "p %", "right", "SNR dB"]
+    figure = "SNR dB" if labels else "signal dB"  # each figure by its own name
+    cols = ["file", "truth", "answer", "p %", "right", figure]
     if show_det:
         cols.insert(1, "det")
     rows = []
@@ -55,10 +57,10 @@ def _clips(res: dict, show_det: bool) -> None:
         rows.append(row)
     m = res["model"]
     what = ("labels.csv snr_db (the bands' SNR)" if labels else
-            "measured block SNR of the green channel over one plot bin's area (the bands' SNR)")
+            "the answer's measured signal, as its reason quotes it (signal_db; the bands are on it)")
     # what the columns mean above them, the title last: it is one unwrapped line right over its table
     print_lines(["?: undetermined, the most likely answer shown (why: --json, rows[].reason); "
-                 f"p %: its probability; SNR dB: {what}" + ("; det: labelled detectable" if show_det else "")])
+                 f"p %: its probability; {figure}: {what}" + ("; det: labelled detectable" if show_det else "")])
     print_table(f"{res['task']} by {m['name']} {m['version']}, per clip", cols, rows, pad_edge=False)
     failed: dict[str, int] = {}
     for r in res["rows"]:
@@ -81,10 +83,12 @@ def _bands(res: dict) -> None:
     rows = [[BAND_NAMES.get(b["band"], b["band"]), str(b["clips"]), _of(b["correct"], b["clips"]), str(b["decided"]),
              _of(b["correct_decided"], b["decided"])] for b in res["by_band"]]
     labels = res["snr_source"] == "labels"
-    print_table(f"By SNR band, all {plural(sum(b['clips'] for b in res['by_band']), 'scored clip')} "
-                f"(SNR: {'labels.csv snr_db' if labels else 'measured'})",
+    scored = plural(sum(b["clips"] for b in res["by_band"]), "scored clip")
+    print_table(f"By {'SNR' if labels else 'signal'} band, all {scored} "
+                f"({'SNR: labels.csv snr_db' if labels else 'measured signal_db'})",
                 ["band", "clips", "right", "decided", "right of decided"], rows)
-    lines = [] if labels else ["The labels give no snr_db: bands are on the measured SNR (see the SNR column)."]
+    lines = [] if labels else ["The labels give no snr_db: bands are on the answers' measured signal (signal_db, the "
+                               "figure their reasons quote; see the signal column)."]
     if res.get("min_snr") is not None:
         lines.append(f"--min-snr {res['min_snr']:g}: {plural(res['excluded'], 'clip')} under {res['min_snr']:g} dB "
                      "left out of every figure")
@@ -105,7 +109,7 @@ def _summary(res: dict, show_det: bool) -> None:
         ("right of decided", lambda b: _of(b["correct_decided"], b["decided"], 1)),
         ("errors", lambda b: str(b["errors"])),
     ]
-    print_table("Summary (95 % interval: bootstrap over clips; decided: answers not undetermined)",
+    print_table("Summary (95 % interval: Clopper-Pearson; decided: not undetermined)",
                 ["clips", *blocks], [[name, *(f(b) for b in blocks.values())] for name, f in figures])
     by_reason: dict[str, int] = {}
     for s in res.get("skipped_reasons", []):

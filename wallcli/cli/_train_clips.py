@@ -129,7 +129,8 @@ def transfer_block(block: dict[str, Any], card: dict[str, Any]) -> dict[str, Any
     """The card's headline figures (what ``-v`` and the report quote) from the out-of-fold table."""
     det = block["out_of_fold"]["detectable"]
     n = det["clips"]
-    out = {"description": (f"independent path-traced transfer set, {block['clips']} labelled recordings of other rooms, "
+    out = {"description": (f"independent path-traced transfer set, {block['clips']} labelled rendered recordings of "
+                           "other rooms, "
                            f"out of fold ({block['folds']} folds: each clip answered by a model fitted without it); the "
                            f"headline figures on the {n} where the people are above the camera's noise or the room is empty"),
            "out_of_fold": True, "clips": block["clips"], "scored": n, "errors": 0,

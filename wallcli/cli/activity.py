@@ -45,7 +45,7 @@ def activity(
       wallcli activity clip.mp4 -v
       wallcli activity plots.npz --json
       wallcli activity clip.mp4 --plot timeline.png --stride 32
-      ffmpeg -i rtsp://cam/stream -f nut - | wallcli activity - --follow
+      ffmpeg -i rtsp://cam/stream -c copy -f nut - | wallcli activity - --follow
     """
     run("activity", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,

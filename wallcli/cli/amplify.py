@@ -82,7 +82,8 @@ def amplify(
     32/0, 32/0.1, 16/0.1, 16/0.2, 16/0.3, 8/0.3, 8/0.5. The first whose measured SNR reaches
     12 dB is used, else the one with the highest SNR; then the gain maps +-3 robust sigma of
     that signal onto the display range. A --cells, --smooth or --gain given is used as given
-    (the others are still chosen). The choice is printed with --json (cells, smooth, snr_db).
+    (the others are still chosen). The choice is printed with --json (cells, smooth, and
+    display_snr_db: the display's own SNR, neither count's signal nor snr's pixel SNR).
     The video is still decoded once: those first seconds are held back as small block grids only.
 
     \b
@@ -179,8 +180,14 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds,
         "cells": amp.cells, "cells_mode": "auto" if amp.auto_cells else "given",
         "smooth": amp.smooth_seconds, "smooth_mode": "auto" if amp.auto_smooth else "given",
-        # the SNR (dB) measured on the first --gain-seconds for each pair tried, and the chosen one's
+        # the SNR (dB) measured on the first --gain-seconds for each pair tried, and the chosen one's:
+        # the display's own figure, named so (snr_db, its older name, stays for scripts); neither
+        # count's signal_db nor snr's pixel SNR
         "snr_db": None if measured is None or not np.isfinite(measured) else round(measured, 2),
+        "display_snr_db": None if measured is None or not np.isfinite(measured) else round(measured, 2),
+        "snr_measure": (f"display SNR: the amplified blocks ({amp.cells} across, smoothed over {amp.smooth_seconds:g} s) "
+                        "over their frame-to-frame noise on the first --gain-seconds; not count's signal_db, "
+                        "nor snr's pixel SNR"),
         "tried": [{"cells": c, "smooth": t, "snr_db": round(v, 2) if np.isfinite(v) else None}
                   for (c, t), v in amp.measured.items()],
         "gain": amp.gain, "gain_mode": "auto" if amp.auto_gain else "fixed", "sigma": amp.sigma,

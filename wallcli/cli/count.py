@@ -53,7 +53,7 @@ def count(
       wallcli count clip.mp4 -v
       wallcli count plots.npz --json
       wallcli count clip.mp4 --plot timeline.png --stride 32
-      ffmpeg -i rtsp://cam/stream -f nut - | wallcli count - --follow
+      ffmpeg -i rtsp://cam/stream -c copy -f nut - | wallcli count - --follow
     """
     run("count", input, stride=stride, json_out=json_out, plot=plot, model_path=model, threads=threads,
         follow=follow, roi=roi, force=force, strict=strict,

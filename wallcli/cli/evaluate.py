@@ -26,8 +26,8 @@ def evaluate(
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
                               help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
     min_snr: Optional[float] = number_option(None, "--min-snr", lo=-99, hi=99, help="Score only empty rooms and "
-                                             "clips whose SNR in dB (labels.csv's snr_db, else the measured one) is "
-                                             "at least this; the others are left out of every figure and counted."),
+                                             "clips whose SNR in dB (labels.csv's snr_db, else the answer's measured "
+                                             "signal, signal_db) is at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG, the only file evaluate writes,")),
     strict: bool = strict_option(),
@@ -42,14 +42,16 @@ def evaluate(
     """Score a model on labelled clips: the check to run before relying on it for a room.
 
     Each clip is decoded once, classified exactly as 'wallcli count' / 'activity' would
-    (same model, windows and stride) and its SNR measured (green channel, wallcli snr's
-    estimator at the block size of one space-time plot bin). Prints first the clips right
-    by SNR band (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db
-    column where there is one, else on the measured SNR), accuracy with a 95 % bootstrap
-    interval over clips, how many answers were decided (not 'undetermined') and how often
-    those were right, and the confusion matrix with accuracy per class; then one line per
+    (same model, windows and stride; the answer's signal_db is the figure its reason
+    quotes) and its block SNR measured too (snr_db: green channel, wallcli snr's estimator
+    at the block size of one space-time plot bin). Prints first the clips right by band
+    (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db column where
+    there is one, else on the answers' signal_db, the figure the decided/undetermined
+    thresholds are per band of), accuracy with its exact 95 %
+    interval (Clopper-Pearson, over clips), how many answers were decided (not
+    'undetermined') and how often those were right, and the confusion matrix with accuracy per class; then one line per
     clip: the answer ('?' after it when undetermined; why: --json), the truth, right or
-    not, and the SNR its band is on. With a 'detectable' column, the headline figures are on
+    not, and the figure its band is on. With a 'detectable' column, the headline figures are on
     detectable clips and the same on all clips follow; the bands count every clip. For
     activity, clips with more than one person are skipped; so is a clip whose sidecar is
     damaged, with a warning. A clip that cannot be analysed (missing, corrupt, too short)

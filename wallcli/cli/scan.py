@@ -60,8 +60,9 @@ def scan(
       wallcli scan recordings/ -o results.jsonl
       wallcli scan cam1/ cam2/ --glob '*.mkv' --task count,snr -o day.csv
       wallcli scan @todo.txt -o results.jsonl --scheduler tcp://10.0.0.5:8786
-      jq -r 'select(.error == null) | [.input, (if .count.confident
-        then .count.label else "undetermined" end)] | @tsv' results.jsonl
+      jq -r 'select(.error == null) | [.input, (.count | if .confident
+        then .label else "undetermined, most likely \\(.label)" end)]
+        | @tsv' results.jsonl
     """
     import os
 

@@ -57,7 +57,7 @@ def simulate(
     world: str = typer.Option("room", "--world", help="room: 3-D box room with articulated people; flatland: the paper's 2-D world (supplementary §4) "
                               "(people = 1-2 moving occluders, horizontal information only); pt: the same rooms and "
                               "motions path traced by Mitsuba 3 (people of boxes, three bounces; needs "
-                              "pip install 'wallcli[pt]'; slow on a CPU, meant for a GPU); mixed (--dataset only): room "
+                              "pip install mitsuba==3.9.1; slow on a CPU, meant for a GPU); mixed (--dataset only): room "
                               "with some flatland count scenes."),
     draws: int = number_option(1, "--draws", lo=1, hi=1000, integer=True, help="--dataset --world pt: cameras drawn "
                                "over each clean path-traced scene (noise, gain, tone curve, codec, lighting nuisances "

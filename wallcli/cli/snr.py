@@ -240,6 +240,9 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
           _triple(s["snr_db"], format_db, 5)] for s in result["scales"]],
     )
     print_lines([f"Why the verdict: {result['verdict']['why']}."])
+    from wallcli.wording import view_note_lines
+
+    print_lines(view_note_lines(result.get("view")))  # as count and activity say them
 
 
 def _triple(v, fmt=None, width: int = 7) -> str:

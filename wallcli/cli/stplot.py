@@ -40,7 +40,8 @@ def stplot(
     Examples:
       wallcli stplot clip.mp4 -o plots.npz --png plots.png
       wallcli stplot clip.mp4 --roi 100,50,640,360 --png w.png --style diverging
-      ffmpeg -i rtsp://cam/s -f nut - | wallcli stplot - --mean ema -o live.npz
+      ffmpeg -i rtsp://cam/s -c copy -f nut - |
+        wallcli stplot - --mean ema -o live.npz
     """
     from wallcli.cli.common import use_stream
 

@@ -9,7 +9,7 @@ import typer
 
 from wallcli.cli.common import force_help, number_option, threads_option
 
-INSTALL_HINT = "pip install torch==2.13.0 && pip install 'wallcli[train]'"
+from wallcli.extras import TRAIN as INSTALL_HINT
 
 
 class Task(str, Enum):
@@ -105,7 +105,8 @@ def train(
     is validated after every epoch and exported at the end (--select); the card records the
     data recipe, the training settings, the validation accuracy and confusion matrix, and the
     sha256 of the .onnx.
-    Needs the optional extra: pip install torch==2.13.0 && pip install 'wallcli[train]'.
+    Needs PyTorch and onnx: pip install torch==2.13.0 'onnx>=1.15' (from the top folder
+    of the checkout: pip install torch==2.13.0 && pip install '.[train]').
 
     \b
     Examples:

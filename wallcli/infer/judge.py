@@ -25,11 +25,20 @@ def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None
 
 def _gate(model, raw, probs, confident: bool, reason):
     """An activity answer where two people may be moving is not decided, whatever the net says
-    (:class:`wallcli.infer.twostage.OnePersonActivity`); its reason replaces the model's."""
+    (:class:`wallcli.infer.twostage.OnePersonActivity`). Its reason is the one that decided: the
+    two-people check's where the card's thresholds would have decided the answer; else theirs,
+    with the check after it (a one-person clip read "two people possible (p=0.05 ...)" alone,
+    while no band has a threshold and nothing would have been decided anyway)."""
     if not hasattr(model, "gate"):
         return confident, reason
-    why = model.gate(raw, model.classes[int(np.argmax(probs))])[1]
-    return (False, why) if why else (confident, reason)
+    p_two, why = model.gate(raw, model.classes[int(np.argmax(probs))])
+    if not why:
+        return confident, reason
+    if confident:
+        return False, why
+    from wallcli.infer.twostage import two_people_aside
+
+    return False, f"{reason}; {two_people_aside(p_two)}"
 
 
 def judge_view(rec: dict[str, Any], view: dict) -> dict[str, Any]:

@@ -172,6 +172,15 @@ def two_people_reason(p_two: float, level: float) -> str:
             f"{level_text(level)} of the time): one activity is not defined for two people")
 
 
+def two_people_aside(p_two: float | None) -> str:
+    """The two-people check said after the reason that decided (the card's thresholds): short, as a
+    reason is one sentence."""
+    if p_two is None:
+        return "and two people cannot be ruled out (the count model cannot read these windows)"
+    how = "likely" if p_two >= 0.5 else "possible"
+    return f"two people {how} too (p={p_two:.2f} of two among people moving)"
+
+
 class OnePersonActivity:
     """The activity task's classifier: the activity net, checked by the count net on the same windows.
 

@@ -101,6 +101,13 @@ RAW_DEMUXERS = frozenset({"h264", "hevc", "vvc", "m4v", "mpegvideo", "cavsvideo"
                           "mjpeg", "dnxhd"})
 RAW_DEFAULT_FPS = 25  # what FFmpeg assumes for such a stream that states no rate
 
+# Lossy legacy codecs that ffmpeg writes by default to a pipe (NUT and AVI: MPEG-4 Part 2; MPEG-TS:
+# MPEG-2) or on a plain -c mjpeg, and that no current camera streams: on stdin they mean the
+# camera's stream was re-encoded (`-f nut -` without `-c copy`), which changes the faint wall
+# signal and so the answers (examples/walking.mp4 through `-f nut` answers otherwise than the file)
+REENCODED = {"mpeg4": "MPEG-4 Part 2", "msmpeg4v1": "MS MPEG-4 v1", "msmpeg4v2": "MS MPEG-4 v2",
+             "msmpeg4": "MS MPEG-4 v3", "mjpeg": "Motion JPEG", "mpeg1video": "MPEG-1", "mpeg2video": "MPEG-2"}
+
 
 def _real_video(stream) -> bool:
     """A stream of moving pictures that FFmpeg can decode, not a cover picture or a thumbnail track."""
@@ -398,6 +405,11 @@ class VideoReader:
             container=container_name,
             fps_source=fps_source,
         )
+        if self._input is not None and not self.following and self.info.codec in REENCODED:
+            self._warn(f"{source}: the stream is {REENCODED[self.info.codec]} ({self.info.codec}), a lossy codec "
+                       "ffmpeg re-encodes to when not told to copy (e.g. `-f nut -`); a re-encode changes the "
+                       "wall's faint signal and the answers: copy the stream instead "
+                       "(ffmpeg -i SOURCE -c copy -f nut -)")
         self.rotation = 0  # quarter turns (np.rot90's k) applied to every frame: its display matrix
         self._rotation_noted = False
         self._peek_rotation(target, fmt, options)

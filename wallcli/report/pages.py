@@ -66,15 +66,20 @@ def clip_page(a, *, command: str) -> str:
     from wallcli.report.cards import model_summary
     from wallcli.report.figures import clip_figures
 
+    from wallcli.snr.verdict import snr_verdict
+    from wallcli.wording import VIEW_NOTE
+
     figures = clip_figures(a)
+    rows = _snr_rows(a.snr)
     tasks = [_task_view(t, a.results.get(t), a.failures.get(t), figures.get(f"timeline_{t}"))
              for t in ("count", "activity")]
     return render(
         "clip.html.j2",
-        title=a.identity["path"], command=command, roi=list(a.roi),
+        title=a.identity["path"], command=command, roi=list(a.roi), view_note=VIEW_NOTE,
         identity=dict(a.identity, container=container_name(a.identity.get("container"), a.identity.get("path"))),
-        snr={"rows": _snr_rows(a.snr), "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
-             "pixels": a.snr.sampled_pixels, "channels": CHANNELS},
+        # the verdict `wallcli snr` leads with, on the page's own figures (its ROI, these rows)
+        snr={"rows": rows, "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
+             "pixels": a.snr.sampled_pixels, "channels": CHANNELS, "verdict": snr_verdict({"scales": rows})},
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
         plot={"bins": a.plot.bins, "frames": a.identity["frames"]},
         figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],

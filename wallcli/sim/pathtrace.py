@@ -25,7 +25,7 @@ multi-jittered: on a walker 1.5 m from the wall (24 x 32 points, 256 spp) the Mo
 the column profiles of dE / E is 1.7 per mille against 6.2 for independent samples at the same
 cost (0.7 per mille at 1024 spp; the walker's own signal there is ~20-40 per mille).
 
-Mitsuba is optional (``pip install 'wallcli[pt]'``) and imported only here, inside functions.
+Mitsuba is optional (the ``pt`` extra; wallcli/extras.py says how to install it) and imported only here, inside functions.
 Variant: ``WALLCLI_PT_VARIANT`` if set, else cuda_ad_rgb where a CUDA device works, else
 llvm_ad_rgb (needs libLLVM), else scalar_rgb.
 """
@@ -37,6 +37,7 @@ import os
 import numpy as np
 
 from wallcli.errors import WallcliError
+from wallcli.extras import PT
 from wallcli.sim import bodies
 from wallcli.sim.room import NORMALS, TEX, Room, surface_uv_to_xyz
 
@@ -54,7 +55,7 @@ _BOX_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0
 N_BOXES = 2 + 2 * len(LIMBS)
 
 
-MISSING = ("--world pt needs the path tracer Mitsuba 3, which is not installed", "pip install 'wallcli[pt]'")
+MISSING = ("--world pt needs the path tracer Mitsuba 3, which is not installed", PT)
 
 
 def require() -> None:

@@ -42,7 +42,7 @@ class SceneConfig:
     nuisance_p: float = 0.35
     camera_overrides: dict = field(default_factory=dict)
     # light transport: 'room' = the analytic renderer (room.py, people of spheres); 'pt' = Mitsuba 3
-    # path tracing of the same scene with people of boxes (pathtrace.py; needs wallcli[pt])
+    # path tracing of the same scene with people of boxes (pathtrace.py; needs the pt extra)
     world: str = "room"
     spp: int = 256  # pt: samples per wall point and frame
     # room world: bodies also shadow the room's other surfaces (shadows.py), a whole-wall dimming the

@@ -1,4 +1,4 @@
-"""Training (optional extra ``wallcli[train]``: torch is imported only inside this package).
+"""Training (the optional extra ``train``, see wallcli/extras.py: torch is imported only inside this package).
 
 - ``nets``: the seed's counting and two-branch activity CNNs, input (N, 3, 64, 256).
 - ``data``: the simulator's shard datasets, planned per epoch so resume is exact.

@@ -9,7 +9,6 @@ all folds together are the candidate's figure. No window of a clip is ever in tw
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import Any
 
@@ -96,13 +95,13 @@ def clip_signal_db(model, rec: Recording) -> float:
     return round(float(np.mean(window_signal_db(parts))), 2)
 
 
-def wilson(k: int, n: int, z: float = 1.959963984540054) -> list[float] | None:
-    if n == 0:
-        return None
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return [round(max(0.0, c - h), 4), round(min(1.0, c + h), 4)]
+def _interval(k: int, n: int) -> list[float] | None:
+    """The 95 % interval of k right of n, rounded for the card: the exact (Clopper-Pearson) one
+    that evaluate prints, so that a card and evaluate's table on the same clips agree."""
+    from wallcli.evaluate.score import exact_ci
+
+    ci = exact_ci(k, n)
+    return None if ci is None else [round(ci[0], 4), round(ci[1], 4)]
 
 
 def oof_table(recs: list[Recording], answers: dict[str, dict], task: str, classes: list) -> dict[str, Any]:
@@ -127,7 +126,7 @@ def oof_table(recs: list[Recording], answers: dict[str, dict], task: str, classe
                 dec_n += 1
                 dec_right += a["label"] == truth(r, task)
     return {"detectable": {"right": int(det_right), "clips": det_n,
-                           "accuracy": round(det_right / det_n, 4) if det_n else None, "ci95": wilson(det_right, det_n),
+                           "accuracy": round(det_right / det_n, 4) if det_n else None, "ci95": _interval(det_right, det_n),
                            "decided": dec_n, "decided_right": dec_right, "confusion_matrix": conf_det.tolist()},
             "by_band": by_band, "confusion_matrix": conf.tolist(),
             "confusion_matrix_axes": "rows: true class, columns: answer, both in the order of classes"}

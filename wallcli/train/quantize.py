@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from wallcli.errors import WallcliError
+from wallcli.extras import ONNX
 from wallcli.infer.card import OUTPUT_NAME
 
 METHOD = ("onnxruntime static QDQ of the convolution trunks: 7-bit weights (int8 storage, |w| <= 64) per output "
@@ -55,7 +56,7 @@ def quantize_int8(src: Path, dst: Path, calib: dict[str, np.ndarray], batch: int
         from onnxruntime.quantization.shape_inference import quant_pre_process
     except ImportError as e:  # the train extra brings onnx
         raise WallcliError(f"int8 quantisation needs the onnx package ({e})",
-                           hint="pip install 'wallcli[train]'") from None
+                           hint=ONNX) from None
 
     n = min(len(v) for v in calib.values())
     if n == 0:
