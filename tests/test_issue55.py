@@ -37,3 +37,25 @@ def test_scan_force_that_fails_before_a_line_leaves_the_old_results(tmp_path, ru
     assert code == 1 and stdout == "" and "127.0.0.1:1" in _one_error(err)
     assert out.read_text() == "old results, a line per video\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["c.mkv", name])
+
+
+# 2 ------------------------------------------- a short write to stdout is an error, -u or not
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_FSIZE emulates a nearly full disk")
+@pytest.mark.parametrize("unbuffered", ["1", ""])
+def test_stdout_cut_short_by_a_full_disk_fails_even_unbuffered(tmp_path, unbuffered):
+    import resource
+
+    from clips import write_plot
+
+    plot = write_plot(tmp_path / "p.npz", seconds=20)
+    out = tmp_path / "o.json"
+
+    def small_disk():  # the file may grow to 200 bytes: the first write is cut short, the next fails
+        resource.setrlimit(resource.RLIMIT_FSIZE, (200, 200))
+
+    env = {**os.environ, "PYTHONUNBUFFERED": unbuffered}
+    with open(out, "wb") as f:
+        run = subprocess.run([sys.executable, "-m", "wallcli", "count", str(plot), "--json"], stdout=f,
+                             stderr=subprocess.PIPE, preexec_fn=small_disk, env=env, timeout=120)
+    assert run.returncode == 1 and out.stat().st_size == 200
+    assert "cannot write to stdout" in _one_error(run.stderr.decode())
