@@ -59,3 +59,31 @@ def test_stdout_cut_short_by_a_full_disk_fails_even_unbuffered(tmp_path, unbuffe
                              stderr=subprocess.PIPE, preexec_fn=small_disk, env=env, timeout=120)
     assert run.returncode == 1 and out.stat().st_size == 200
     assert "cannot write to stdout" in _one_error(run.stderr.decode())
+
+
+# 3 ------------------------------------------------------------ amplify keeps the source's times
+def _times(path) -> list[float]:
+    import av
+
+    with av.open(str(path)) as c:
+        return [float(f.pts * f.time_base) for f in c.decode(video=0)]
+
+
+@pytest.mark.parametrize("case", ["gap", "10fps", "vfr"])
+def test_amplify_output_frames_keep_their_source_times(tmp_path, run_cli, case):
+    if case == "gap":  # 3 s at 30 fps, 2 s of frames missing, 3 s more
+        n, fps, tb = 180, 30, Fraction(1, 30)
+        pts = lambda i: i if i < 90 else i + 60  # noqa: E731
+    elif case == "10fps":  # the stream says 30 fps, its frames are 0.1 s apart
+        n, fps, tb = 40, 30, Fraction(1, 30)
+        pts = lambda i: 3 * i  # noqa: E731
+    else:  # a phone's variable rate: intervals of 1/30 and 1/15 s, in a 1/1000 s time base
+        n, fps, tb = 90, 30, Fraction(1, 1000)
+        pts = lambda i: round(1000 * (i / 30 + (i // 2) / 30))  # noqa: E731
+    src = write_clip(tmp_path / "src.mkv", lambda i: _wall(i, 48, 64), n, fps=fps, codec="ffv1", pix_fmt="bgr0",
+                     options={}, pts_fn=pts, time_base=tb)
+    code, _, err = run_cli("amplify", src, tmp_path / "amp.mp4", "--gain", "10")
+    assert code == 0, err
+    want, got = _times(src), _times(tmp_path / "amp.mp4")
+    assert len(got) == len(want) == n
+    assert np.allclose(np.array(got) - got[0], np.array(want) - want[0], atol=0.002), (got[-1], want[-1])

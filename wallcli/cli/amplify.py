@@ -143,12 +143,13 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         out_w = 2 * pw if side_by_side else pw
         frames = 0
         with atomic_path(output, force=force) as tmp:
-            with VideoWriter(tmp, info.fps, out_w, ph, crf=crf, preset=preset) as writer:
+            # timed: each output frame keeps its source frame's time (frames lost, variable rates)
+            with VideoWriter(tmp, info.fps, out_w, ph, crf=crf, preset=preset, timed=True) as writer:
 
                 def write(pairs) -> None:
-                    for left, display in pairs:
+                    for (t, left), display in pairs:
                         right = render_panel(display, pw, ph)
-                        writer.write(right if left is None else np.concatenate([left, right], axis=1))
+                        writer.write(right if left is None else np.concatenate([left, right], axis=1), t)
 
                 with progress("amplify", info.frame_count) as advance:
                     for frame in itertools.chain([first] if first is not None else [], frames_in):
@@ -165,7 +166,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                         # the grids of every block count still in question, from this one decode
                         grids = {c: rgb_grid(planes, roi_t, *grid_shape(rw, rh, c)) for c in amp.wanted}
                         left = original_panel(planes, roi_t, pw, ph) if side_by_side else None
-                        write(amp.push(frame.time, grids, left))
+                        write(amp.push(frame.time, grids, (frame.time, left)))
                         frames += 1
                         advance()
                 write(amp.flush() if amp is not None else [])

@@ -346,6 +346,7 @@ class VideoWriter:
         pix_fmt: str | None = None,
         preset: str = "medium",
         repeatable: bool = False,
+        timed: bool = False,
     ):
         """``repeatable``: the same frames always give the same file (the simulator's promise:
         a seed gives one video). Two things in x264 break that by default, both measured here:
@@ -385,13 +386,26 @@ class VideoWriter:
             # or readers guess BT.709 for HD sizes and shift the colours.
             stream.codec_context.colorspace = 6
             stream.codec_context.color_range = 1
+        # write(rgb, t): each frame at its source's time (gaps, variable rates), in ticks of about
+        # 1/90000 s (MPEG's clock) of which a frame at ``fps`` lasts a whole number: a steady
+        # source stays exactly steady (24000/1001 in 1/90000 s ticks read back as 23.9759 fps)
+        self._tick = Fraction(fps.denominator, fps.numerator * max(1, -(-90000 * fps.denominator // fps.numerator)))
+        if timed:
+            stream.codec_context.time_base = stream.time_base = self._tick
         self._stream = stream
         self._av = av
+        self._timed = timed
+        self._last_pts = -1
         self.frames = 0
 
-    def write(self, rgb) -> None:
+    def write(self, rgb, t: float | None = None) -> None:
+        """``t``: the frame's time in seconds (a ``timed`` writer); otherwise frames follow at ``fps``."""
         frame = self._av.VideoFrame.from_ndarray(rgb, format="rgb24")
         frame.pts = None
+        if self._timed and t is not None:
+            # strictly increasing, as muxers require, even where two source times round together
+            frame.pts = self._last_pts = max(round(float(t) / self._tick), self._last_pts + 1)
+            frame.time_base = self._tick
         for packet in self._stream.encode(frame):
             self._container.mux(packet)
         self.frames += 1
