@@ -87,3 +87,55 @@ def test_amplify_output_frames_keep_their_source_times(tmp_path, run_cli, case):
     want, got = _times(src), _times(tmp_path / "amp.mp4")
     assert len(got) == len(want) == n
     assert np.allclose(np.array(got) - got[0], np.array(want) - want[0], atol=0.002), (got[-1], want[-1])
+
+
+# 4 ---------------------------------------------------- frame rates from the frames' own times
+def _labelled_30(tmp_path, name, step, n=40):
+    """A clip whose stream says 30 fps while its frames are ``step`` seconds apart (microsecond times)."""
+    import av
+
+    tb = Fraction(1, 1_000_000)
+    with av.open(str(tmp_path / name), "w") as c:
+        s = c.add_stream("ffv1", rate=30)
+        s.width, s.height, s.pix_fmt = 64, 48, "bgr0"
+        s.codec_context.time_base = tb
+        for i in range(n):
+            f = av.VideoFrame.from_ndarray(np.clip(_wall(i, 48, 64), 0, 255).astype(np.uint8), format="rgb24")
+            f.pts, f.time_base = round(i * step / tb), tb
+            for p in s.encode(f):
+                c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+    return tmp_path / name
+
+
+def test_stplot_and_snr_report_the_rate_the_frames_run_at(tmp_path, run_cli):
+    from wallcli.io.arrays import load_npz
+
+    src = _labelled_30(tmp_path, "ten.mkv", 0.1)
+    code, _, err = run_cli("stplot", src, "-o", tmp_path / "p.npz", "--bins", "16")
+    assert code == 0, err
+    arrays, meta = load_npz(tmp_path / "p.npz")
+    assert meta["fps"] == pytest.approx(1 / np.median(np.diff(arrays["time"]))) == pytest.approx(10)
+    code, out, err = run_cli("snr", src, "--json")
+    assert code == 0, err
+    assert json.loads(out)["fps"] == pytest.approx(10)
+
+
+@pytest.mark.parametrize("command", ["snr", "stplot", "amplify"])
+@pytest.mark.parametrize("step", [3600.0, 0.001])
+def test_rates_outside_10_to_240_fps_are_refused_by_every_command(tmp_path, run_cli, command, step):
+    src = _labelled_30(tmp_path, "odd.mkv", step, n=20)
+    args = {"stplot": ["-o", tmp_path / "p.npz"], "amplify": [tmp_path / "a.mp4"]}.get(command, [])
+    code, out, err = run_cli(command, src, *args)
+    assert code == 1 and out == ""
+    assert "wallcli reads videos of 10 to 240 fps" in _one_error(err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["odd.mkv"]
+
+
+def test_a_30_fps_gif_reads_30_fps(tmp_path, run_cli):
+    gif = write_clip(tmp_path / "g.gif", lambda i: _wall(i, 48, 64), 60, fps=30, codec="gif", pix_fmt="rgb8",
+                     options={})  # delays of 3, 3 and 4 centiseconds, which FFmpeg's rate reads as 33.3
+    code, out, err = run_cli("snr", gif, "--json")
+    assert code == 0, err
+    assert json.loads(out)["fps"] == pytest.approx(30, abs=0.1)

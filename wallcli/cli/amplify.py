@@ -115,6 +115,7 @@ def amplify(
 def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
             preset, json_out, force, threads) -> None:
     import itertools
+    from fractions import Fraction
 
     import numpy as np
 
@@ -173,10 +174,12 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                 if frames < 2:
                     raise WallcliError(f"{input}: only {frames} frame(s); amplify needs at least 2")
     rows, cols = grid_shape(rw, rh, amp.cells)
+    rate = reader.fps  # the frames' own rate where it contradicts the container's
+    rate_f = info.fps if rate == float(info.fps) else Fraction(rate).limit_denominator(1001)
     measured = amp.measured.get((amp.cells, amp.smooth_seconds))
     summary = {
-        "input": input, "output": str(output), "frames": frames, "fps": float(info.fps),
-        "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}", "width": out_w, "height": ph,
+        "input": input, "output": str(output), "frames": frames, "fps": rate,
+        "fps_fraction": f"{rate_f.numerator}/{rate_f.denominator}", "width": out_w, "height": ph,
         "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds,
         "cells": amp.cells, "cells_mode": "auto" if amp.auto_cells else "given",
         "smooth": amp.smooth_seconds, "smooth_mode": "auto" if amp.auto_smooth else "given",

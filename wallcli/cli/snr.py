@@ -193,7 +193,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
                 if feed_grid is not None:
                     feed_grid.update(frame.planes)
                 advance()
-        fps = float(reader.info.fps)
+        fps = reader.fps  # the frames' own rate where it contradicts the container's
     notes += [str(w.message) for w in caught]
     result = snr_report(acc, source=input, fps=fps, notes=notes,
                         roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))

@@ -12,6 +12,7 @@ the queue, whatever the video's length.
 
 from __future__ import annotations
 
+import math
 import os
 import queue
 import re
@@ -55,6 +56,10 @@ _QUEUE_SIZE = 8
 # answering about interpolated samples (a 0.5 fps file gave eight windows and 32 dB, snr -99 dB);
 # far above 240 fps, the timestamps of slow-motion files are rarely the capture's.
 MIN_FPS, MAX_FPS = 10.0, 240.0
+# The frame intervals whose median the rate check reads (the rest of a file is checked by then), and
+# how far the frames' measured rate may stray from the container's before it is the one reported
+RATE_PROBE = 16
+RATE_TOLERANCE = 0.02
 
 
 def check_rate(fps: float, source: str) -> None:
@@ -75,7 +80,7 @@ class VideoInfo:
     duration: float | None
     codec: str = ""  # FFmpeg's decoder name, e.g. 'h264' (for reports of the evidence)
     container: str = ""  # FFmpeg's demuxer name, e.g. 'mov,mp4,m4a,3gp,3g2,mj2'
-    fps_source: str = "container"  # where fps came from: 'container', 'codec' (its headers) or 'assumed'
+    fps_source: str = "container"  # where fps came from: 'container', 'codec' (its headers) or 'assumed' (a plot's meta: also 'timestamps')
 
 
 @dataclass
@@ -404,6 +409,34 @@ class VideoReader:
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs
         self.gaps: list[tuple[float, float]] = []  # (time of the frame before, time of the frame after) per jump
+        self._steady = [0, 0.0]  # frame intervals that are no gap: how many, their sum in seconds
+
+    @property
+    def measured_fps(self) -> float | None:
+        """The frames' own rate so far: intervals counted, gaps (frames lost) not; None before two frames."""
+        n, total = self._steady
+        return n / total if n and total > 0 else None
+
+    @property
+    def fps(self) -> float:
+        """The rate to report once the frames are read: the container's, unless the timestamps say
+        otherwise by more than RATE_TOLERANCE (a stream labelled 30 fps whose frames are 0.1 s
+        apart, a 30 fps GIF whose 3-3-4 centisecond delays are read as 33.3 fps)."""
+        got, said = self.measured_fps, float(self.info.fps)
+        return got if got is not None and abs(got - said) > RATE_TOLERANCE * said else said
+
+    def _check_intervals(self, intervals: list[float]) -> None:
+        """Refuse (check_rate) frames whose median spacing is outside the rates wallcli reads,
+        whatever the container says (one frame an hour in a file labelled 30 fps); one tick of
+        the time base either way is the timestamps' rounding (240 fps in milliseconds: 4 or 5)."""
+        if len(intervals) < 2:
+            return
+        m = float(np.median(intervals))
+        tick = float(self._stream.time_base or 0)
+        fastest = 1.0 / max(m - tick, 1e-12)
+        slowest = 1.0 / (m + tick) if m + tick > 0 else math.inf
+        if fastest < MIN_FPS or slowest > MAX_FPS:
+            check_rate(1.0 / m if m > 0 else math.inf, self.source)
 
     def _pick_stream(self, source: str, index: int | None):
         """The video stream to read: ``index`` (--stream N) or the first real one; a file with
@@ -509,6 +542,8 @@ class VideoReader:
 
         recent: deque = deque(maxlen=GAP_HISTORY)
         self.gaps = []
+        self._steady = [0, 0.0]
+        first_intervals: list[float] | None = []  # the first RATE_PROBE, then None (checked)
         size = None  # (width, height) of the first frame: every analysis holds per-pixel state of that size
         try:
             while True:
@@ -533,6 +568,13 @@ class VideoReader:
                             self.gaps.append((round(last_time, 4), round(t, 4)))
                         else:
                             recent.append(dt)
+                            self._steady[0] += 1
+                            self._steady[1] += dt
+                        if first_intervals is not None:
+                            first_intervals.append(dt)
+                            if len(first_intervals) >= RATE_PROBE:
+                                self._check_intervals(first_intervals)
+                                first_intervals = None
                     last_time = t
                     planes = self._turn(frame, frame_planes(frame))
                     if size is None:
@@ -558,6 +600,8 @@ class VideoReader:
                         more = f" and {len(self.gaps) - 3} more" if len(self.gaps) > 3 else ""
                         self._warn(f"{self.source}: frames missing (the timestamps jump): {shown}{more}; "
                                    "what spans a gap is not analysed as continuous (view: 'frame gap')")
+                    if first_intervals is not None:
+                        self._check_intervals(first_intervals)
                     self._check_complete(index, last_time)
                     break
         finally:

@@ -15,6 +15,7 @@ import os
 import stat
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
+from fractions import Fraction
 from pathlib import Path
 from typing import Any, Callable
 
@@ -171,7 +172,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         raise WallcliError(f"{source} has {rows.frames} frame(s); a space-time plot needs at least 2 "
                            "(the temporal mean of one frame is the frame itself)")
     plot = thumb.plot(rows, first.bins, first.fps)
-    plot.meta.update(frame_size=list(rows.frame_size), fps_fraction=f"{info.fps.numerator}/{info.fps.denominator}")
+    rate = info.fps if reader.fps == float(info.fps) else Fraction(reader.fps).limit_denominator(1001)
+    plot.meta.update(frame_size=list(rows.frame_size), fps_fraction=f"{rate.numerator}/{rate.denominator}")
     notes = list(dict.fromkeys([str(w.message) for w in caught] + list(reader.warnings)))
     if tee.snr is not None:
         tee.snr.finish()  # frames still waiting for their corrections' gains
@@ -187,7 +189,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
                 notes.append(f"{source} changed while it was analysed; its size and sha256 are those from before")
         except OSError:
             notes.append(f"{source} disappeared while it was analysed")
-    fps = float(info.fps)
+    fps = reader.fps  # as snr and stplot report it
     identity = {
         "path": str(source), **facts,
         "container": info.container, "codec": info.codec, "pix_fmt": info.pix_fmt,
