@@ -139,3 +139,17 @@ def test_a_30_fps_gif_reads_30_fps(tmp_path, run_cli):
     code, out, err = run_cli("snr", gif, "--json")
     assert code == 0, err
     assert json.loads(out)["fps"] == pytest.approx(30, abs=0.1)
+
+
+# 6 ----------------------------------------------------- ROIs too small for the view check
+@pytest.mark.parametrize("roi", ["0,0,2,2", "0,0,7,7", "0,0,4,120", "0,0,160,4", "0,0,20,20"])
+def test_an_roi_too_small_to_check_is_no_usable_view(tmp_path, run_cli, roi):
+    src = write_clip(tmp_path / "w.mkv", lambda i: _wall(i, 120, 160), 40, fps=30, codec="ffv1", pix_fmt="bgr0",
+                     options={})
+    code, out, err = run_cli("snr", src, "--roi", roi, "--json")
+    assert code == 0, err
+    view = json.loads(out)["view"]
+    assert view["usable"] is False and view["issues"] == ["too small to check"]
+    assert "33x33 pixels" in view["reason"]
+    code, out, err = run_cli("snr", src, "--roi", roi, "--json", "--strict")
+    assert code == 1 and "33x33 pixels" in _one_error(err)
