@@ -153,3 +153,55 @@ def test_an_roi_too_small_to_check_is_no_usable_view(tmp_path, run_cli, roi):
     assert "33x33 pixels" in view["reason"]
     code, out, err = run_cli("snr", src, "--roi", roi, "--json", "--strict")
     assert code == 1 and "33x33 pixels" in _one_error(err)
+
+
+# 9 ------------------------------------------------------------------------- internal errors
+def test_a_frame_640_times_wider_than_high_is_no_internal_error(tmp_path, run_cli):
+    src = write_clip(tmp_path / "wide.nut", lambda i: _wall(i, 16, 16384), 12, fps=30, codec="rawvideo",
+                     pix_fmt="yuv444p", options={})
+    for command in ("snr", "stplot"):
+        code, out, err = run_cli(command, src, "--json")
+        assert code == 0 and "internal error" not in err, err
+        assert json.loads(out)["view"]["issues"] == ["too thin to check"]
+    code, out, err = run_cli("count", src, "--json")  # too short, said as such: not a crash
+    assert code == 1 and "too short" in _one_error(err)
+
+
+def test_snr_predict_gain_below_a_millionth_is_a_usage_error(run_cli):
+    code, out, err = run_cli("snr", "--predict", "--mean-code", "100", "--gain", "1e-200")
+    assert code == 2 and out == "" and "--gain" in _one_error(err) and "1e-06" in err
+
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
+
+
+def _model_with(tmp_path, **changes) -> Path:
+    import shutil
+
+    shutil.copy(MODELS / "count.onnx", tmp_path / "m.onnx")
+    card = json.loads((MODELS / "count.json").read_text())
+    for key, value in changes.items():
+        target = card
+        *parents, leaf = key.split(".")
+        for p in parents:
+            target = target[p]
+        target[leaf] = value
+    (tmp_path / "m.json").write_text(json.dumps(card))
+    return tmp_path / "m.onnx"
+
+
+@pytest.mark.parametrize("field,value,words", [
+    ("two_stage.confidence.thresholds", "x", "thresholds"),
+    ("two_stage.confidence.thresholds", [[0]], "thresholds"),
+    ("two_stage.confidence.level", 2, "level"),
+    ("two_stage.prior_two_vs_one", 1e308, "prior_two_vs_one"),
+    ("two_stage.prior_two_vs_one", -1, "prior_two_vs_one"),
+    ("two_stage.prior_two_vs_one", "1:4", "prior_two_vs_one"),
+    ("classes", ["a", "b", "c"], "classes"),
+])
+def test_two_stage_and_class_fields_of_a_card_are_validated_on_load(tmp_path, run_cli, field, value, words):
+    from clips import write_plot
+
+    plot = write_plot(tmp_path / "p.npz")
+    code, out, err = run_cli("count", plot, "--model", _model_with(tmp_path, **{field: value}), "--json")
+    assert code == 1 and out == "" and words in _one_error(err)
