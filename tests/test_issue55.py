@@ -205,3 +205,43 @@ def test_two_stage_and_class_fields_of_a_card_are_validated_on_load(tmp_path, ru
     plot = write_plot(tmp_path / "p.npz")
     code, out, err = run_cli("count", plot, "--model", _model_with(tmp_path, **{field: value}), "--json")
     assert code == 1 and out == "" and words in _one_error(err)
+
+
+# 7 ---------------------------------------------------------------------- duplicates and truth
+def test_evaluate_refuses_byte_identical_copies(tmp_path, run_cli):
+    from wallcli.errors import WallcliError
+    from wallcli.evaluate.labels import read_labels
+
+    (tmp_path / "a.mp4").write_bytes(b"one recording")
+    (tmp_path / "b.mp4").write_bytes(b"one recording")
+    (tmp_path / "labels.csv").write_text("file,people,activity\na.mp4,1,walking\nb.mp4,1,walking\n")
+    with pytest.raises(WallcliError, match="byte-identical"):
+        read_labels(tmp_path)
+    code, out, err = run_cli("evaluate", tmp_path, "--task", "count")
+    assert code == 1 and out == "" and "byte-identical" in _one_error(err)
+
+
+def test_a_sidecar_without_activities_gives_counts_truth_from_moving(tmp_path):
+    from wallcli.evaluate.labels import read_labels
+
+    (tmp_path / "a.mp4").write_bytes(b"a")
+    (tmp_path / "a.json").write_text(json.dumps({"people": 2, "moving": 1, "activity": "walking"}))
+    (clip,) = read_labels(tmp_path).clips
+    assert clip.people == 1 and clip.persons == 2
+
+
+def test_scan_inputs_name_a_hard_linked_pair_once(tmp_path):
+    from wallcli.batch.inputs import expand_inputs
+
+    (tmp_path / "a.mp4").write_bytes(b"a")
+    os.link(tmp_path / "a.mp4", tmp_path / "b.mp4")
+    assert expand_inputs([str(tmp_path)]) == [str(tmp_path / "a.mp4")]
+
+
+def test_report_counts_one_recording_under_two_names_once(tmp_path):
+    from wallcli.report.scan import read_results
+
+    line = {"input": "a.mp4", "size": 1, "sha256": "ab" * 32, "tasks": ["snr"], "error": None}
+    (tmp_path / "r.jsonl").write_text(json.dumps(line) + "\n" + json.dumps({**line, "input": "b.mp4"}) + "\n")
+    records, problems = read_results(tmp_path / "r.jsonl")
+    assert [r["input"] for r in records] == ["b.mp4"] and "same sha256" in problems[0]
