@@ -245,3 +245,40 @@ def test_report_counts_one_recording_under_two_names_once(tmp_path):
     (tmp_path / "r.jsonl").write_text(json.dumps(line) + "\n" + json.dumps({**line, "input": "b.mp4"}) + "\n")
     records, problems = read_results(tmp_path / "r.jsonl")
     assert [r["input"] for r in records] == ["b.mp4"] and "same sha256" in problems[0]
+
+
+# 10 --------------------------------------------------------------------- evidence and leftovers
+def test_a_report_on_a_local_playlist_hashes_the_media_it_names(tmp_path, run_cli):
+    from wallcli.infer.card import sha256_file
+
+    seg = write_clip(tmp_path / "seg0.ts", lambda i: _wall(i, 48, 64), 30, fps=30, fmt="mpegts")
+    (tmp_path / "live.m3u8").write_text("#EXTM3U\n#EXT-X-VERSION:3\n#EXT-X-TARGETDURATION:1\n"
+                                        "#EXTINF:1.0,\nseg0.ts\n#EXT-X-ENDLIST\n")
+    code, _, err = run_cli("report", tmp_path / "live.m3u8", "-o", tmp_path / "r.html")
+    assert code == 0, err
+    assert sha256_file(seg) in (tmp_path / "r.html").read_text()
+
+
+def test_dataset_force_removes_the_old_sets_extra_shards(tmp_path):
+    from wallcli.datagen.dataset import build_dataset
+
+    d = tmp_path / "ds"
+    d.mkdir()
+    (d / "shard-00007.npz").write_bytes(b"an older, larger set's shard")
+    m = build_dataset(d, 1, "count", seed=3, jobs=1, windows_per_scene=1, shard_scenes=1, grid=(6, 8), force=True,
+                      camera_overrides={"fps": 15.0, "width": 64, "height": 48, "codec": "ffv1"})
+    assert sorted(p.name for p in d.glob("shard-*.npz")) == [s["file"] for s in m["shards"]] == ["shard-00000.npz"]
+
+
+def test_leftover_temporaries_of_killed_runs_are_removed_not_those_of_live_ones(tmp_path, clip, run_cli):
+    import fcntl
+
+    dead = tmp_path / ".p.abcd1234.tmp.npz"
+    dead.write_bytes(b"half a plot of a run killed with SIGKILL")
+    live = tmp_path / ".p.efgh5678.tmp.npz"
+    live.write_bytes(b"a plot being written by another run")
+    with open(live, "rb") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz", "--bins", "16")
+    assert code == 0, err
+    assert not dead.exists() and live.exists() and (tmp_path / "p.npz").exists()

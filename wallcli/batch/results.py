@@ -289,7 +289,7 @@ class ResultsFile:
             self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
 
     def _replace(self) -> None:
-        from wallcli.io.writer import atomic_path
+        from wallcli.io.writer import atomic_path, release_temporary
 
         kept, self._pending = self._pending, None
         header = [csv_record(self.columns)] if self.columns is not None else []
@@ -300,6 +300,7 @@ class ResultsFile:
                 # locked before the rename, and the lock goes with the file: there is no moment
                 # when the path names an unlocked file another scan could take
                 new = os.open(tmp, os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0))
+                release_temporary(tmp)  # the writer's own lock on it gives way to this one
                 _lock(new, self.path)
         except OSError as exc:
             if new is not None:
