@@ -282,3 +282,62 @@ def test_leftover_temporaries_of_killed_runs_are_removed_not_those_of_live_ones(
         code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz", "--bins", "16")
     assert code == 0, err
     assert not dead.exists() and live.exists() and (tmp_path / "p.npz").exists()
+
+
+# 5 ------------------------------------------------------- --follow and recorders that flush slowly
+def _fragmented_mp4(path, n=600):
+    """A fragmented MP4 (a fragment a second), as a recorder that must survive a power cut writes it."""
+    import av
+
+    rng = np.random.default_rng(0)
+    with av.open(str(path), "w", options={"movflags": "frag_keyframe+empty_moov"}) as c:
+        s = c.add_stream("libx264", rate=30)
+        s.width, s.height, s.pix_fmt = 64, 48, "yuv420p"
+        s.options = {"crf": "12", "preset": "ultrafast", "g": "30"}
+        for i in range(n):
+            img = np.clip(np.full((48, 64, 3), 100.0) + rng.normal(0, 2, (48, 64, 3)), 0, 255).astype(np.uint8)
+            for p in s.encode(av.VideoFrame.from_ndarray(img, format="rgb24")):
+                c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+    return path.read_bytes()
+
+
+def test_follow_waits_for_a_header_and_for_a_recorder_slower_than_the_idle_timeout(tmp_path):
+    import threading
+    import time
+
+    whole = _fragmented_mp4(tmp_path / "whole.mp4")
+    growing = tmp_path / "rec.mp4"
+    ftyp = int.from_bytes(whole[:4], "big")
+    growing.write_bytes(whole[:ftyp])  # only the 'ftyp' box: the header is still being written
+    stop = threading.Event()
+    # pauses of 0.9 s (under --idle-timeout 1), then of 2 s (over it, under 3 times the pauses seen)
+    pauses = [0.9] * 4 + [2.0] * 4
+
+    def record():
+        with open(growing, "ab") as f:
+            for i, pause in enumerate(pauses):
+                if stop.wait(pause):
+                    return
+                f.write(whole[ftyp + i * (len(whole) - ftyp) // len(pauses):ftyp + (i + 1) * (len(whole) - ftyp) // len(pauses)])
+                f.flush()
+
+    t = threading.Thread(target=record, daemon=True)
+    start = time.monotonic()
+    t.start()
+    try:
+        p = subprocess.run([sys.executable, "-m", "wallcli", "count", str(growing), "--follow", "--idle-timeout", "1"],
+                           capture_output=True, text=True, timeout=120)
+    finally:
+        stop.set()
+        t.join(10)
+    assert p.returncode == 0, p.stderr
+    clip = json.loads(p.stdout.splitlines()[-1])
+    assert clip["windows"][-1]["end"] == pytest.approx(20.0, abs=0.1)
+    assert time.monotonic() - start >= sum(pauses)
+
+
+def test_follow_default_idle_timeout_outlasts_a_5_s_flush(run_cli):
+    code, out, _ = run_cli("count", "--help")
+    assert code == 0 and "default: 15" in " ".join(out.split()).replace("[", "").lower()

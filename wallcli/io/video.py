@@ -46,6 +46,7 @@ _POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal 
 # --follow on a regular file: read it as it grows, until it has not grown for this many seconds
 # (None: read what is there, as any file)
 FOLLOW_IDLE: ContextVar[float | None] = ContextVar("wallcli_follow_idle", default=None)
+FLUSH_FACTOR = 3.0  # a followed file ends after this many of its longest pauses between growths, if longer
 
 
 _QUEUE_SIZE = 8
@@ -163,7 +164,9 @@ def _front_to_back(path: str) -> bool:
             for _ in range(64):
                 box = fh.read(8)
                 if len(box) < 8:
-                    return False
+                    # its header is still being written (nothing after 'ftyp' yet): what follows
+                    # will tell, and a reader that waits for it loses nothing
+                    return True
                 size, kind = struct.unpack(">I4s", box)
                 if kind in (b"moov", b"moof"):
                     return True
@@ -190,6 +193,7 @@ class StreamInput:
     def __init__(self, source: str, path: str | None, stall: float | None, idle: float | None = None) -> None:
         self.source, self.stall = source, stall
         self.idle = idle  # a growing file: at its end, wait this long for more before calling it the end
+        self._longest = 0.0  # the longest time between two of its growths: how slowly its recorder flushes
         self.interrupted = False  # a signal arrived while FFmpeg read in the main thread
         self._q: queue.Queue = queue.Queue(maxsize=64)
         self._stop = threading.Event()
@@ -218,12 +222,16 @@ class StreamInput:
             os.close(fd)
 
     def _grows(self, fd: int) -> bool:
-        """At the end of a file being written: whether it grows within ``idle`` seconds."""
+        """At the end of a file being written: whether it grows within ``idle`` seconds, or within
+        FLUSH_FACTOR times the longest pause between its growths so far (a recorder that flushes
+        every 5 s outlasted a 5 s --idle-timeout and was taken for finished)."""
         import time
 
         end, waited = os.lseek(fd, 0, os.SEEK_CUR), 0.0
-        while not self._stop.is_set() and waited < self.idle:
+        while not self._stop.is_set() and waited < max(self.idle, FLUSH_FACTOR * self._longest):
             if os.fstat(fd).st_size > end:
+                # the wait is a lower bound of the recorder's pause (not the time we spent reading)
+                self._longest = max(self._longest, waited)
                 return True
             time.sleep(_POLL)
             waited += _POLL
