@@ -341,3 +341,55 @@ def test_follow_waits_for_a_header_and_for_a_recorder_slower_than_the_idle_timeo
 def test_follow_default_idle_timeout_outlasts_a_5_s_flush(run_cli):
     code, out, _ = run_cli("count", "--help")
     assert code == 0 and "default: 15" in " ".join(out.split()).replace("[", "").lower()
+
+
+# 8 ------------------------------------------------------------------ memory and interruption
+def test_amplify_refuses_output_frames_beyond_two_4k_panels_up_front(tmp_path, run_cli, clip):
+    code, out, err = run_cli("amplify", clip, tmp_path / "a.mp4", "--scale", "300")  # 9600x7200
+    assert code == 2 and out == "" and "9600x7200" in _one_error(err) and "megapixels" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.mkv"]
+
+
+def test_a_writer_left_by_an_error_does_not_encode_what_its_encoder_holds(tmp_path):
+    from wallcli.io.writer import VideoWriter
+
+    calls = []
+
+    class Counting:  # the stream, counting the encoder's drains (encode() with no frame)
+        def __init__(self, stream):
+            self._s = stream
+
+        def encode(self, frame=None):
+            calls.append(frame is None)
+            return self._s.encode(frame)
+
+    with pytest.raises(KeyboardInterrupt):
+        with VideoWriter(tmp_path / "v.mp4", 30, 64, 48, preset="ultrafast") as w:
+            w._stream = Counting(w._stream)
+            for _ in range(5):
+                w.write(np.zeros((48, 64, 3), np.uint8))
+            raise KeyboardInterrupt
+    assert calls and not any(calls)
+
+
+def test_a_compressed_npz_that_unpacks_far_beyond_its_size_is_refused_before_reading(tmp_path, run_cli):
+    import zipfile
+
+    from numpy.lib import format as npy
+
+    frames, bins = 400_000, 64  # 307 MB a plot once unpacked, a few hundred kB packed
+    path = tmp_path / "bomb.npz"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
+        for name in ("horizontal", "vertical"):
+            with zf.open(name + ".npy", "w", force_zip64=True) as f:
+                npy.write_array_header_1_0(f, {"descr": "<f4", "fortran_order": False, "shape": (bins, frames, 3)})
+                zeros = bytes(1 << 22)
+                for _ in range(bins * frames * 3 * 4 // len(zeros)):
+                    f.write(zeros)
+        with zf.open("time.npy", "w") as f:
+            npy.write_array(f, np.arange(frames) / 30.0)
+        with zf.open("meta.npy", "w") as f:
+            npy.write_array(f, np.array(json.dumps({"format": "wallcli.stplot", "format_version": 1, "bins": bins,
+                                                    "fps": 30.0, "roi": [0, 0, 64, 48]})))
+    code, out, err = run_cli("count", path, "--json")
+    assert code == 1 and out == "" and "unpacks to" in _one_error(err) and "GB" in err

@@ -14,6 +14,10 @@ VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # (the original panel); cap that buffer so 4K input cannot blow the memory budget.
 PRESETS = ("ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower", "veryslow")
 SIDE_BUFFER_BYTES = 64 * 1024 * 1024
+# The largest output frame: two 4K UHD panels side by side. Memory grows with the output's pixels
+# (measured here: 420 MB at 2560x1920; --scale 100 of a 64x48 ROI, 6400x4800, reached 7.5 GB as
+# the encoder's threads each held frames), and a block grid blown up further shows nothing more.
+MAX_OUTPUT_PIXELS = 2 * 3840 * 2160
 
 
 def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
@@ -58,7 +62,7 @@ def amplify(
                                  "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion. "
                                  "Default: automatic (0 to 0.5, with --cells; see below)."),
     scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5; rounded to even sizes, at least 2x2) or "
-                       "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0)."),
+                       "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0). The output frame is at most 2x3840x2160 pixels."),
     side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Output shows the ROI only."),
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),
@@ -120,7 +124,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
     import numpy as np
 
     from wallcli.cli.output import emit_json, progress, wrote
-    from wallcli.errors import WallcliError
+    from wallcli.errors import UsageError, WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import VideoWriter, atomic_path
     from wallcli.signal.amplify import AutoAmplifier, grid_shape, original_panel, quantisation_sigma, render_panel
@@ -142,6 +146,10 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         depth = 8
         amp = None
         out_w = 2 * pw if side_by_side else pw
+        if out_w * ph > MAX_OUTPUT_PIXELS:
+            raise UsageError(f"--scale {scale} makes {out_w}x{ph} output frames ({out_w * ph / 1e6:.1f} megapixels); "
+                             f"amplify writes at most {MAX_OUTPUT_PIXELS / 1e6:.1f} (two 3840x2160 panels): "
+                             "use a smaller --scale")
         frames = 0
         with atomic_path(output, force=force) as tmp:
             # timed: each output frame keeps its source frame's time (frames lost, variable rates)
