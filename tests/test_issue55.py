@@ -393,3 +393,20 @@ def test_a_compressed_npz_that_unpacks_far_beyond_its_size_is_refused_before_rea
                                                     "fps": 30.0, "roi": [0, 0, 64, 48]})))
     code, out, err = run_cli("count", path, "--json")
     assert code == 1 and out == "" and "unpacks to" in _one_error(err) and "GB" in err
+
+
+def test_a_pan_of_a_high_contrast_wall_is_not_read_as_still(tmp_path, run_cli):
+    import cv2
+
+    big = cv2.GaussianBlur(np.random.default_rng(0).normal(0, 1, (112, 136)).astype(np.float32), (0, 0), 2.0)
+    big = 120 + 25 * big / big.std()  # a poster or brickwork: the texture is all 'edges' to the check
+
+    def frame(i):
+        dx = int(round(15 * np.sin(2 * np.pi * i / 60)))  # +-15 px
+        return np.repeat(big[20:92, 20 + dx:116 + dx, None], 3, axis=2) + np.random.default_rng(i).normal(0, 1, (72, 96, 1))
+
+    src = write_clip(tmp_path / "pan.mp4", frame, 120, fps=30)
+    code, out, err = run_cli("snr", src, "--json")
+    assert code == 0, err
+    view = json.loads(out)["view"]
+    assert view["issues"] and view["max_shift_px"] > 10, view

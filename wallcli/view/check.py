@@ -330,6 +330,8 @@ class ViewCheck:
                 verdict = _motion_verdict(bands, matches, still, dx, dy)
                 if verdict is None:
                     flags.add("motion not verifiable")
+                    # the shift measured, unverified: max_shift_px 0 read as 'did not move'
+                    self.max_shift = max(self.max_shift, shift)
                 elif verdict:
                     flags.add("camera motion")
                     self.max_shift = max(self.max_shift, shift)
