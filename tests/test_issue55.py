@@ -410,3 +410,26 @@ def test_a_pan_of_a_high_contrast_wall_is_not_read_as_still(tmp_path, run_cli):
     assert code == 0, err
     view = json.loads(out)["view"]
     assert view["issues"] and view["max_shift_px"] > 10, view
+
+
+def test_scan_force_interrupted_before_a_line_leaves_the_old_results(tmp_path, clip):
+    import signal
+    import socket
+    import time
+
+    out = tmp_path / "keep.jsonl"
+    out.write_text("old results\n")
+    with socket.socket() as server:  # takes the connection, never answers Dask's handshake
+        server.bind(("127.0.0.1", 0))
+        server.listen(4)
+        port = server.getsockname()[1]
+        p = subprocess.Popen([sys.executable, "-m", "wallcli", "scan", str(clip), "-o", str(out), "--force",
+                              "--scheduler", f"tcp://127.0.0.1:{port}"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        server.settimeout(60)
+        conn, _ = server.accept()  # scan is waiting for the handshake now
+        time.sleep(0.5)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=60)
+        conn.close()
+    assert p.returncode == 1 and "interrupted" in _one_error(err.decode())
+    assert out.read_text() == "old results\n"
