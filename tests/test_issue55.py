@@ -277,6 +277,8 @@ def test_leftover_temporaries_of_killed_runs_are_removed_not_those_of_live_ones(
     dead.write_bytes(b"half a plot of a run killed with SIGKILL")
     live = tmp_path / ".p.efgh5678.tmp.npz"
     live.write_bytes(b"a plot being written by another run")
+    for p in (dead, live):  # both last written a minute ago
+        os.utime(p, (p.stat().st_mtime - 60,) * 2)
     with open(live, "rb") as held:
         fcntl.flock(held, fcntl.LOCK_EX)
         code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz", "--bins", "16")

@@ -46,7 +46,7 @@ _POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal 
 # --follow on a regular file: read it as it grows, until it has not grown for this many seconds
 # (None: read what is there, as any file)
 FOLLOW_IDLE: ContextVar[float | None] = ContextVar("wallcli_follow_idle", default=None)
-FLUSH_FACTOR = 3.0  # a followed file ends after this many of its longest pauses between growths, if longer
+FLUSH_FACTOR = 3.0  # a followed file ends after this many of its longest waits for growth, if longer
 
 
 _QUEUE_SIZE = 8
@@ -81,7 +81,9 @@ class VideoInfo:
     duration: float | None
     codec: str = ""  # FFmpeg's decoder name, e.g. 'h264' (for reports of the evidence)
     container: str = ""  # FFmpeg's demuxer name, e.g. 'mov,mp4,m4a,3gp,3g2,mj2'
-    fps_source: str = "container"  # where fps came from: 'container', 'codec' (its headers) or 'assumed' (a plot's meta: also 'timestamps')
+    # where fps came from: 'container', 'codec' (its headers) or 'assumed'; a plot's meta also
+    # 'timestamps' (the frames' own rate, where it contradicts the container's)
+    fps_source: str = "container"
 
 
 @dataclass
@@ -193,7 +195,7 @@ class StreamInput:
     def __init__(self, source: str, path: str | None, stall: float | None, idle: float | None = None) -> None:
         self.source, self.stall = source, stall
         self.idle = idle  # a growing file: at its end, wait this long for more before calling it the end
-        self._longest = 0.0  # the longest time between two of its growths: how slowly its recorder flushes
+        self._longest = 0.0  # the longest wait at its end before it grew: how slowly its recorder flushes
         self.interrupted = False  # a signal arrived while FFmpeg read in the main thread
         self._q: queue.Queue = queue.Queue(maxsize=64)
         self._stop = threading.Event()

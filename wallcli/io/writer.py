@@ -6,6 +6,7 @@ import errno
 import os
 import stat
 import tempfile
+import time
 from contextlib import contextmanager
 from contextvars import ContextVar
 from fractions import Fraction
@@ -95,6 +96,7 @@ def _check_target(out: Path, *, force: bool) -> None:
 
 # temporaries being written -> an open descriptor holding a lock on each (see _temporary)
 _HELD: dict[str, int] = {}
+SWEEP_AGE = 10.0  # seconds since a leftover temporary was last written
 
 
 def _temporary(out: Path, hold: bool = False) -> Path:
@@ -159,7 +161,9 @@ def _sweep(parent: Path, prefix: str, suffix: str) -> None:
         except OSError:
             continue
         try:
-            if stat.S_ISREG(os.fstat(fd).st_mode) and _try_lock(fd):
+            st = os.fstat(fd)
+            # a few seconds old at least: one just made by mkstemp may not be locked by its run yet
+            if stat.S_ISREG(st.st_mode) and time.time() - st.st_mtime > SWEEP_AGE and _try_lock(fd):
                 os.unlink(name)
         except OSError:
             pass
