@@ -435,3 +435,15 @@ def test_scan_force_interrupted_before_a_line_leaves_the_old_results(tmp_path, c
         conn.close()
     assert p.returncode == 1 and "interrupted" in _one_error(err.decode())
     assert out.read_text() == "old results\n"
+
+
+def test_a_reader_that_leaves_early_is_an_error_even_unbuffered(tmp_path):
+    from clips import write_plot
+
+    plot = write_plot(tmp_path / "long.npz", seconds=900)  # --json of 200 kB: over a pipe's 64 kB
+    p = subprocess.Popen([sys.executable, "-m", "wallcli", "count", str(plot), "--json"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    assert p.stdout.read(1)  # `| head -c1`
+    p.stdout.close()
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=120) == 1 and "closed by its reader" in _one_error(err)
