@@ -63,7 +63,7 @@ def test_a_deep_sidecar_is_a_damaged_one(tmp_path):
 # ------------------------------------------------------------------- 6: one clip reached two ways
 def _labelled(tmp_path, third: str):
     for v in ("a.mp4", "b.mp4"):
-        (tmp_path / v).write_bytes(b"not decoded here")
+        (tmp_path / v).write_bytes(f"{v}: not decoded here".encode())  # two copies of one are one clip (issue 55)
     (tmp_path / "labels.csv").write_text(f"file,people,activity\na.mp4,1,walking\nb.mp4,0,none\n{third},1,walking\n")
     return tmp_path
 
@@ -81,13 +81,18 @@ def test_a_clip_linked_twice_is_a_duplicate(tmp_path, link, run_cli):
     assert code == 1 and out == "" and _one_line(err) and len(err.splitlines()) == 1
 
 
-def test_a_copy_and_a_missing_clip_are_not_duplicates(tmp_path):
+def test_a_missing_clip_is_not_a_duplicate_a_byte_identical_copy_is(tmp_path):
+    from wallcli.errors import WallcliError
     from wallcli.evaluate.labels import read_labels
 
     d = _labelled(tmp_path, "c.mp4")
-    (d / "c.mp4").write_bytes((d / "a.mp4").read_bytes())  # same bytes, another file: two clips
+    (d / "c.mp4").write_bytes((d / "a.mp4").read_bytes() + b"\0")  # another recording
     (d / "labels.csv").write_text((d / "labels.csv").read_text() + "gone.mp4,0,none\n")
     assert [c.file for c in read_labels(d).clips] == ["a.mp4", "b.mp4", "c.mp4", "gone.mp4"]
+    # issue 55: the same bytes under another name is one recording scored twice
+    (d / "c.mp4").write_bytes((d / "a.mp4").read_bytes())
+    with pytest.raises(WallcliError, match="byte-identical"):
+        read_labels(d)
 
 
 # ------------------------------------------------------------------- 10: a huge line in labels.csv

@@ -11,7 +11,7 @@ from wallcli.evaluate.labels import read_labels
 
 def _folder(tmp_path, csv_text: str, videos=("a.mp4", "b.mp4")):
     for v in videos:
-        (tmp_path / v).write_bytes(b"not decoded here")
+        (tmp_path / v).write_bytes(f"{v}: not decoded here".encode())  # two copies of one are one clip
     (tmp_path / "labels.csv").write_text(csv_text)
     return tmp_path
 

@@ -89,7 +89,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         else:
             for _ in tee.frames():
                 pass
-        fps = float(info.fps)
+        fps = reader.fps  # as snr reports it
         notes = list(reader.warnings)
     out: dict[str, Any] = {"frames": unique.decoded, "duration": round(unique.last_time + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes, "view": check.summary()}

@@ -65,13 +65,14 @@ def expand_inputs(args: list[str], globs: list[str] | None = None, skip: str | o
     """
     skipped = _identity(skip) if skip is not None else None
     out: list[str] = []
-    seen: set[str] = set()
+    seen: set = set()
     empty_folders = []
 
     def add(source: str) -> None:
-        key = source if is_url(source) else os.path.realpath(source)
-        if key not in seen:
-            seen.add(key)
+        # one file by any name (./a.mp4, a symlink, a hard link) is one video: scanned once
+        keys = {source} if is_url(source) else {os.path.realpath(source), _identity(source)} - {None}
+        if not keys & seen:
+            seen.update(keys)
             out.append(source)
 
     for arg in args:

@@ -8,7 +8,8 @@ at most one torn last line, which the next run drops. On that next run, lines of
 unchanged (same sha256), scanned for the same tasks, with the same options (each line records them
 under "options") and the same models are kept and their videos skipped; errors, videos that
 changed and lines made with other options or models are done again and their old lines dropped,
-so each video keeps exactly one line.
+so each video keeps exactly one line. Rewriting the file (--force, or dropping such lines) waits
+for the run's first new line: a run that ends before one leaves the file as it was.
 """
 from __future__ import annotations
 
@@ -237,6 +238,7 @@ class ResultsFile:
         self.appended = 0
         self._fd: int | None = None
         self._fh = None
+        self._pending: list[Entry] | None = None  # lines the file is to be replaced by (start)
 
     def open(self) -> None:
         """Open the file, creating it if absent, and take its lock; a scan already holding it is
@@ -280,29 +282,44 @@ class ResultsFile:
         return csv_record(flatten(line, self.columns))
 
     def start(self, kept: list[Entry] | None) -> None:
-        """Start appending. ``kept`` None: the file is right as it is; otherwise it is replaced,
-        atomically, by a fresh file holding the header and ``kept``'s lines."""
-        if kept is not None:
-            from wallcli.io.writer import atomic_path
+        """Start appending. ``kept`` None: the file is right as it is; otherwise it is to be
+        replaced, atomically, by a fresh file holding the header and ``kept``'s lines, but only
+        once this run stores its first line or ends well: a run that fails or is interrupted
+        before that (an unreachable cluster, Ctrl-C at start-up) leaves the old file as it was,
+        --force's old results included."""
+        self._pending = kept
+        if kept is None:
+            self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
 
-            header = [csv_record(self.columns)] if self.columns is not None else []
-            new = None
-            try:
-                with atomic_path(self.path, force=True) as tmp:
-                    tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
-                    # locked before the rename, and the lock goes with the file: there is no moment
-                    # when the path names an unlocked file another scan could take
-                    new = os.open(tmp, os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0))
-                    _lock(new, self.path)
-            except BaseException:
-                if new is not None:
-                    os.close(new)
-                raise
-            os.close(self._fd)
-            self._fd = new
+    def _replace(self) -> None:
+        from wallcli.io.writer import atomic_path, release_temporary
+
+        kept, self._pending = self._pending, None
+        header = [csv_record(self.columns)] if self.columns is not None else []
+        new = None
+        try:
+            with atomic_path(self.path, force=True) as tmp:
+                tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
+                # locked before the rename, and the lock goes with the file: there is no moment
+                # when the path names an unlocked file another scan could take
+                new = os.open(tmp, os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0))
+                release_temporary(tmp)  # the writer's own lock on it gives way to this one
+                _lock(new, self.path)
+        except OSError as exc:
+            if new is not None:
+                os.close(new)
+            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
+        except BaseException:
+            if new is not None:
+                os.close(new)
+            raise
+        os.close(self._fd)
+        self._fd = new
         self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
 
     def append(self, line: dict) -> None:
+        if self._pending is not None:
+            self._replace()
         # one write of the whole line, then flush and fsync: the line is on disk before the next
         # one starts, and a kill can tear at most the line being written
         try:
@@ -314,6 +331,9 @@ class ResultsFile:
         self.appended += 1
 
     def close(self) -> None:
+        """End a run that went well: a replacement still pending (no line stored) is made now."""
+        if self._pending is not None and self._fd is not None:
+            self._replace()
         fh, fd, self._fh, self._fd = self._fh, self._fd, None, None
         try:
             if fh is not None:
@@ -326,6 +346,7 @@ class ResultsFile:
     def abandon(self) -> None:
         """Close after a failure; a file this run created and never wrote a line to is removed
         (while still locked, so no other scan can have opened it meanwhile)."""
+        self._pending = None  # the old file stays as it was: nothing new replaces it
         try:
             if self.created and not self.appended:
                 self.path.unlink(missing_ok=True)

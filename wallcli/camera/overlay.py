@@ -126,7 +126,10 @@ class OverlayFilter:
         return (y.astype(np.float32) / np.float32(1 << (planes.depth - 8))).astype(np.float32)
 
     def _observe(self, planes) -> None:
-        if min(planes.y.shape) < 16:  # a frame too thin for a line of text (4000x16, 1x1000)
+        h, w = planes.y.shape
+        # a frame too thin for a line of text (4000x16, 1x1000), or whose sampling lattice would be
+        # under two samples across (16384x16: one sample in 52 each way)
+        if min(h, w) < 16 or min(h, w) // -(-max(h, w) // MAX_SIDE) < 2:
             self._big.append(None)
             return
         s = self._sample(planes)

@@ -32,9 +32,11 @@ VERBOSE_OPT = typer.Option(False, "--verbose", "-v", help="Also print, on stderr
                            "each window's reason is. Without it: the table and one line saying why the answer is "
                            "decided or not.")
 FOLLOW_OPT = typer.Option(False, "--follow", help="Live or growing input: print one JSON line per window as soon as it is complete (JSON Lines, with or without --json).")
-IDLE_OPT = number_option(5.0, "--idle-timeout", lo=0, hi=1e6,
+# 15 s: three times the 5 s many recorders flush at (at 5 s a recorder flushing every 5 s was taken
+# for finished after its second flush)
+IDLE_OPT = number_option(15.0, "--idle-timeout", lo=0, hi=1e6,
                          help="With --follow on a file: keep reading it as a recorder writes it, and end when it "
-                              "has not grown for this many seconds.")
+                              "has not grown for this many seconds (or for 3 times its longest pause so far).")
 ROI_OPT = typer.Option(None, "--roi", help=ROI_HELP)
 FORCE_OPT = typer.Option(False, "--force", help=force_help("the --plot file"))
 INPUT_ARG = input_argument(INPUT_HELP)
@@ -49,7 +51,7 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
         strict: bool = False, no_deflicker: bool = False, no_exposure: bool = False,
         no_shake: bool = False, stream: Optional[int] = None, activity_model: Optional[Path] = None,
         single_stage: bool = False, verbose: bool = False, stall_timeout: Optional[float] = None,
-        idle_timeout: float = 5.0) -> None:
+        idle_timeout: float = 15.0) -> None:
     from wallcli.cli.common import use_stream
     from wallcli.errors import UsageError
 

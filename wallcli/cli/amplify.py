@@ -14,6 +14,10 @@ VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv")
 # (the original panel); cap that buffer so 4K input cannot blow the memory budget.
 PRESETS = ("ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower", "veryslow")
 SIDE_BUFFER_BYTES = 64 * 1024 * 1024
+# The largest output frame: two 4K UHD panels side by side. Memory grows with the output's pixels
+# (measured here: 420 MB at 2560x1920; --scale 100 of a 64x48 ROI, 6400x4800, reached 7.5 GB as
+# the encoder's threads each held frames), and a block grid blown up further shows nothing more.
+MAX_OUTPUT_PIXELS = 2 * 3840 * 2160
 
 
 def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
@@ -58,7 +62,7 @@ def amplify(
                                  "(causal one-pole low-pass; 0 = off). Lowers noise, blurs fast motion. "
                                  "Default: automatic (0 to 0.5, with --cells; see below)."),
     scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5; rounded to even sizes, at least 2x2) or "
-                       "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0)."),
+                       "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0). The output frame is at most 2x3840x2160 pixels."),
     side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Output shows the ROI only."),
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),
@@ -116,11 +120,12 @@ def amplify(
 def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
             preset, json_out, force, threads) -> None:
     import itertools
+    from fractions import Fraction
 
     import numpy as np
 
     from wallcli.cli.output import emit_json, progress, wrote
-    from wallcli.errors import WallcliError
+    from wallcli.errors import UsageError, WallcliError
     from wallcli.io.video import open_video
     from wallcli.io.writer import VideoWriter, atomic_path
     from wallcli.signal.amplify import AutoAmplifier, grid_shape, original_panel, quantisation_sigma, render_panel
@@ -142,14 +147,19 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         depth = 8
         amp = None
         out_w = 2 * pw if side_by_side else pw
+        if out_w * ph > MAX_OUTPUT_PIXELS:
+            raise UsageError(f"--scale {scale} makes {out_w}x{ph} output frames ({out_w * ph / 1e6:.1f} megapixels); "
+                             f"amplify writes at most {MAX_OUTPUT_PIXELS / 1e6:.1f} (two 3840x2160 panels): "
+                             "use a smaller --scale")
         frames = 0
         with atomic_path(output, force=force) as tmp:
-            with VideoWriter(tmp, info.fps, out_w, ph, crf=crf, preset=preset) as writer:
+            # timed: each output frame keeps its source frame's time (frames lost, variable rates)
+            with VideoWriter(tmp, info.fps, out_w, ph, crf=crf, preset=preset, timed=True) as writer:
 
                 def write(pairs) -> None:
-                    for left, display in pairs:
+                    for (t, left), display in pairs:
                         right = render_panel(display, pw, ph)
-                        writer.write(right if left is None else np.concatenate([left, right], axis=1))
+                        writer.write(right if left is None else np.concatenate([left, right], axis=1), t)
 
                 with progress("amplify", info.frame_count) as advance:
                     for frame in itertools.chain([first] if first is not None else [], frames_in):
@@ -166,17 +176,19 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                         # the grids of every block count still in question, from this one decode
                         grids = {c: rgb_grid(planes, roi_t, *grid_shape(rw, rh, c)) for c in amp.wanted}
                         left = original_panel(planes, roi_t, pw, ph) if side_by_side else None
-                        write(amp.push(frame.time, grids, left))
+                        write(amp.push(frame.time, grids, (frame.time, left)))
                         frames += 1
                         advance()
                 write(amp.flush() if amp is not None else [])
                 if frames < 2:
                     raise WallcliError(f"{input}: only {frames} frame(s); amplify needs at least 2")
     rows, cols = grid_shape(rw, rh, amp.cells)
+    rate = reader.fps  # the frames' own rate where it contradicts the container's
+    rate_f = info.fps if rate == float(info.fps) else Fraction(rate).limit_denominator(1001)
     measured = amp.measured.get((amp.cells, amp.smooth_seconds))
     summary = {
-        "input": input, "output": str(output), "frames": frames, "fps": float(info.fps),
-        "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}", "width": out_w, "height": ph,
+        "input": input, "output": str(output), "frames": frames, "fps": rate,
+        "fps_fraction": f"{rate_f.numerator}/{rate_f.denominator}", "width": out_w, "height": ph,
         "roi": list(roi_t), "grid": [rows, cols], "mean": mean, "mean_seconds": mean_seconds,
         "cells": amp.cells, "cells_mode": "auto" if amp.auto_cells else "given",
         "smooth": amp.smooth_seconds, "smooth_mode": "auto" if amp.auto_smooth else "given",

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import errno
+import io
 import json
 import math
 import os
@@ -145,7 +147,7 @@ class _GuardedStdout:
         if self._stream is None:  # started with stdout closed (`>&-`): Python sets sys.stdout to None
             raise StdoutError(f"cannot write to stdout: {_reason(None)}")
         try:
-            return getattr(self._stream, name)(*args)
+            return (getattr(self._stream, name) if isinstance(name, str) else name)(*args)
         except BrokenPipeError:
             raise StdoutError(READER_LEFT) from None
         except UnicodeError:
@@ -154,6 +156,9 @@ class _GuardedStdout:
             raise StdoutError(f"cannot write to stdout: {_reason(exc)}") from None
 
     def write(self, text: str) -> int:
+        raw = getattr(self._stream, "buffer", None)
+        if isinstance(raw, io.RawIOBase):
+            return self._call(_write_all, self._stream, raw, text)
         return self._call("write", text)
 
     def flush(self) -> None:
@@ -161,6 +166,22 @@ class _GuardedStdout:
 
     def __getattr__(self, name: str):
         return getattr(self._stream, name)
+
+
+def _write_all(stream, raw, text: str) -> int:
+    """Write ``text`` whole to ``raw``, the unbuffered file under ``stream`` (``python -u``,
+    PYTHONUNBUFFERED=1, common in containers). There the text layer writes straight to it and
+    ignores a short write's count: a nearly full disk or a reader that left mid-way cut the
+    output and the command still exited 0. Here a short write is followed by another, which
+    fails with the reason (ENOSPC, EPIPE)."""
+    data = text.encode(stream.encoding or "utf-8", stream.errors or "strict")
+    view, done = memoryview(data), 0
+    while done < len(data):
+        n = raw.write(view[done:])
+        if not n:  # None: a non-blocking stdout that is full; 0: nothing taken
+            raise OSError(errno.EAGAIN if n is None else errno.ENOSPC, "stdout took no more data")
+        done += n
+    return len(text)
 
 
 @contextmanager

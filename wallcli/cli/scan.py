@@ -29,7 +29,7 @@ def scan(
     glob: Optional[List[str]] = typer.Option(None, "--glob", help="File names to take from folders, e.g. '*.mp4' "
                                              "(repeatable). Default: the usual video extensions, any case."),
     force: bool = typer.Option(False, "--force", help="Start the results file again (every video redone) instead of "
-                               "resuming it."),
+                               "resuming it. The old file stays as it is until the first new line replaces it."),
     windows: bool = typer.Option(False, "--windows", help="Keep every window's answer in count and activity "
                                  "(the lines grow by a few hundred bytes per 2 s of video)."),
     timeout: float = number_option(300.0, "--timeout", lo=0, hi=86400, help="Give a video up (an error line) when its decoder "

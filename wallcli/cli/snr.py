@@ -26,7 +26,8 @@ PREDICT_PARAMS = {
     "occupancy": ("--occupancy", 1.0, "Fraction q of the time the person is there.", dict(lo=0, hi=1)),
     "mean_code": ("--mean-code", None, "Camera model: the wall's mean code value (8-bit scale). With --gain, also "
                   "predicts noise and SNR.", dict(lo=0, hi=255)),
-    "gain": ("--gain", None, "Camera model: electrons per 8-bit code value.", dict(lo=0, hi=1e6, lo_open=True)),
+    # a millionth of an electron per code value and less is no camera, and squared overflows a float
+    "gain": ("--gain", None, "Camera model: electrons per 8-bit code value.", dict(lo=1e-6, hi=1e6)),
     "read_noise": ("--read-noise", 2.0, "Camera model: read noise (electrons RMS).", dict(lo=0, hi=1e6)),
     "bits": ("--bits", 8, "Camera model: bit depth (quantisation step 2^(8-bits) on the 8-bit scale).",
              dict(lo=1, hi=16, integer=True)),
@@ -193,7 +194,7 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
                 if feed_grid is not None:
                     feed_grid.update(frame.planes)
                 advance()
-        fps = float(reader.info.fps)
+        fps = reader.fps  # the frames' own rate where it contradicts the container's
     notes += [str(w.message) for w in caught]
     result = snr_report(acc, source=input, fps=fps, notes=notes,
                         roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))

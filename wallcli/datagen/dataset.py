@@ -135,6 +135,12 @@ def build_dataset(out_dir: str | os.PathLike, n: int, task: str, *, seed: int = 
                 "notes": "windows are stplot output (clip mean removed, 8-bit code units), resampled to 30 fps, "
                          "not normalised; label = people (count) or activity index (activity)"}
     write_text_atomic(manifest_path, json.dumps(manifest, indent=1), force=True)
+    # shards of an earlier, larger dataset (--force with fewer windows) are not this one's: a
+    # reader that globs shard-*.npz would train on them
+    planned = {s["file"] for s in manifest["shards"]}
+    for stale in out.glob("shard-*.npz"):
+        if stale.name not in planned:
+            stale.unlink(missing_ok=True)
     todo = []
     for k, idx, keep in plan:
         path = out / f"shard-{k:05d}.npz"

@@ -9,7 +9,9 @@ against). A labels.csv that cannot be read is a failure of the whole run (exit 1
 a clip that is missing is not: it becomes that clip's error row. A sidecar is one clip's labels, so
 a damaged one (beside its video) skips that clip, with the reason, rather than failing the run.
 Two names for one file (``a.mp4``, ``./a.mp4``, a hard link or symlink to it) are one clip listed
-twice: an error, as any duplicate is, since scoring it twice would weigh it double.
+twice: an error, as any duplicate is, since scoring it twice would weigh it double; so are two
+byte-identical copies. A sidecar without ``activities`` gives the count's truth from ``moving``
+(what ``wallcli simulate`` writes), else from ``people``.
 """
 from __future__ import annotations
 
@@ -93,6 +95,32 @@ def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
                 raise WallcliError(f"{source} names one clip twice: {first} ({other.file!r}) and {where} "
                                    f"({c.file!r}); list each clip once")
         seen.update((key, (where, c)) for key in keys)
+    _no_copies(source, named)
+
+
+def _no_copies(source: Path, named: list[tuple[str, Clip]]) -> None:
+    """Fail on two entries whose files are byte-identical copies: one recording scored twice
+    weighs double, whatever its names. Only files of one size are hashed (copies are rare)."""
+    from wallcli.infer.card import sha256_file
+
+    by_size: dict[int, list[tuple[str, Clip]]] = {}
+    for where, c in named:
+        try:
+            by_size.setdefault(os.stat(c.path).st_size, []).append((where, c))
+        except (OSError, ValueError):
+            pass
+    for group in (g for g in by_size.values() if len(g) > 1):
+        seen: dict[str, tuple[str, Clip]] = {}
+        for where, c in group:
+            try:
+                digest = sha256_file(c.path)
+            except OSError:
+                continue
+            if digest in seen:
+                first, other = seen[digest]
+                raise WallcliError(f"{source} names one recording twice: {first} ({other.file!r}) and {where} "
+                                   f"({c.file!r}) are byte-identical copies; list each clip once")
+            seen[digest] = (where, c)
 
 
 def _from_csv(d: Path) -> tuple[list[Clip], bool]:
@@ -200,6 +228,10 @@ def _sidecar(d: Path, side: Path, beside: list[Path]) -> Clip:
     acts = meta.get("activities")
     if isinstance(acts, list) and all(isinstance(a, str) for a in acts):
         moving = sum(a != "none" for a in acts)  # a still person is not counted (count's task)
+    elif "moving" in meta:  # what simulate writes: the people who move, what count answers
+        moving = _people(meta["moving"], where + " 'moving'")
+        if moving > _people(meta["people"], where):
+            raise WallcliError(f"{where}: 'moving' ({moving}) is more than 'people' ({meta['people']})")
     else:
         moving = _people(meta["people"], where)
     video = meta.get("video")

@@ -124,6 +124,10 @@ def validate_card(card: Any, where: Path | str = "model card") -> None:
         raise bad("field 'classes' must be a list of 2 to 1000 labels (integers or non-empty strings)")
     if len({repr(c) for c in classes}) != len(classes):
         raise bad(f"field 'classes' lists a label twice: {classes}")
+    if classes != TASK_CLASSES[task]:
+        # the answers' words (count's number of people, activity's names), which the two-stage
+        # count, the reports and the truth files compare by value
+        raise bad(f"a {task} model's classes are {TASK_CLASSES[task]} (card lists {classes!r:.80})")
     inputs = card["inputs"]
     if not isinstance(inputs, list) or not all(isinstance(i, dict) for i in inputs):
         raise bad("field 'inputs' must be a list of objects")
@@ -153,6 +157,32 @@ def validate_card(card: Any, where: Path | str = "model card") -> None:
         msg = validate_block(card["confidence"], len(card["classes"]))
         if msg:
             raise bad(msg)
+    if card.get("two_stage") is not None:
+        _validate_two_stage(card["two_stage"], len(card["classes"]), bad)
+
+
+# the prior odds of two people against one that a two-stage count weighs p(2) by: a share of
+# two-person rooms from 1 in 1000 to 999 in 1000 (1e308 made every answer two, -1 became 1 unsaid)
+PRIOR_ODDS = (1e-3, 1e3)
+
+
+def _validate_two_stage(block: Any, n_classes: int, bad) -> None:
+    """The two-stage count's block of a count card (see infer.twostage), as that reads it."""
+    from wallcli.infer.confidence import validate_block
+
+    if not isinstance(block, dict):
+        raise bad("field 'two_stage' must be an object")
+    pair = block.get("activity_model")
+    if pair is not None and not (isinstance(pair, dict) and isinstance(pair.get("sha256", ""), str)):
+        raise bad("field 'two_stage.activity_model' must be an object with the activity model's sha256")
+    if block.get("confidence") is not None:
+        msg = validate_block(block["confidence"], n_classes)
+        if msg:
+            raise bad("two_stage." + msg)
+    odds = block.get("prior_two_vs_one")
+    lo, hi = PRIOR_ODDS
+    if odds is not None and not (_is_number(odds) and lo <= odds <= hi):
+        raise bad(f"field 'two_stage.prior_two_vs_one' must be a number from {lo:g} to {hi:g} (got {odds!r:.40})")
 
 
 def _validate_accuracy(block: Any, name: str, bad) -> None:

@@ -14,6 +14,9 @@ from wallcli.io import jsonfile
 from wallcli.io.writer import atomic_path
 
 META_KEY = "meta"
+# What a .npz may unpack to beyond twice its own size: wallcli writes them uncompressed (about
+# 1:1), and a compressed one of 7 MB declaring 2,000,000 frames (3 GB) took count to 9.2 GB
+UNPACK_FREE = 256 << 20
 
 
 def save_npz(path: str | os.PathLike, arrays: dict[str, np.ndarray], meta: dict, *, force: bool = False) -> None:
@@ -46,6 +49,27 @@ def _write_npy(fid, a: np.ndarray, step_bytes: int = 1 << 16) -> None:
         fid.write(np.ascontiguousarray(a[i:i + step]).data)
 
 
+def _declared_bytes(p: Path) -> int | None:
+    """The bytes the .npy members' headers declare, read before any array is; None if unreadable
+    (np.load then says what is wrong)."""
+    from numpy.lib import format as npy
+
+    total = 0
+    try:
+        with zipfile.ZipFile(p) as zf:
+            for info in zf.infolist():
+                if not info.filename.endswith(".npy"):
+                    continue
+                with zf.open(info) as f:
+                    version = npy.read_magic(f)
+                    read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+                    shape, _, dtype = read(f)
+                total += int(np.prod(shape, dtype=object)) * dtype.itemsize
+    except Exception:  # noqa: BLE001 - damaged: left to np.load's own message
+        return None
+    return total
+
+
 def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[str, np.ndarray], dict]:
     """Load a wallcli ``.npz``; ``kind`` checks ``meta['format']``. Corrupt files raise WallcliError."""
     p = Path(path)
@@ -55,6 +79,11 @@ def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[
     # then advises allow_pickle=True: never the advice for a file a user fed us by mistake.
     if not zipfile.is_zipfile(p):
         raise WallcliError(f"{p} is not a readable .npz file (not a zip archive)")
+    declared = _declared_bytes(p)
+    if declared is not None and declared > max(UNPACK_FREE, 2 * p.stat().st_size):
+        raise WallcliError(f"{p} unpacks to {declared / 1e9:.2f} GB of arrays from {p.stat().st_size / 1e6:.1f} MB "
+                           f"(compressed); wallcli reads a .npz of at most twice its size or "
+                           f"{UNPACK_FREE >> 20} MB", hint="write it uncompressed (np.savez), as wallcli does")
     try:
         with np.load(p, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}

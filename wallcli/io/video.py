@@ -12,6 +12,7 @@ the queue, whatever the video's length.
 
 from __future__ import annotations
 
+import math
 import os
 import queue
 import re
@@ -45,6 +46,7 @@ _POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal 
 # --follow on a regular file: read it as it grows, until it has not grown for this many seconds
 # (None: read what is there, as any file)
 FOLLOW_IDLE: ContextVar[float | None] = ContextVar("wallcli_follow_idle", default=None)
+FLUSH_FACTOR = 3.0  # a followed file ends after this many of its longest waits for growth, if longer
 
 
 _QUEUE_SIZE = 8
@@ -55,6 +57,10 @@ _QUEUE_SIZE = 8
 # answering about interpolated samples (a 0.5 fps file gave eight windows and 32 dB, snr -99 dB);
 # far above 240 fps, the timestamps of slow-motion files are rarely the capture's.
 MIN_FPS, MAX_FPS = 10.0, 240.0
+# The frame intervals whose median the rate check reads (the rest of a file is checked by then), and
+# how far the frames' measured rate may stray from the container's before it is the one reported
+RATE_PROBE = 16
+RATE_TOLERANCE = 0.02
 
 
 def check_rate(fps: float, source: str) -> None:
@@ -75,7 +81,9 @@ class VideoInfo:
     duration: float | None
     codec: str = ""  # FFmpeg's decoder name, e.g. 'h264' (for reports of the evidence)
     container: str = ""  # FFmpeg's demuxer name, e.g. 'mov,mp4,m4a,3gp,3g2,mj2'
-    fps_source: str = "container"  # where fps came from: 'container', 'codec' (its headers) or 'assumed'
+    # where fps came from: 'container', 'codec' (its headers) or 'assumed'; a plot's meta also
+    # 'timestamps' (the frames' own rate, where it contradicts the container's)
+    fps_source: str = "container"
 
 
 @dataclass
@@ -165,7 +173,9 @@ def _front_to_back(path: str) -> bool:
             for _ in range(64):
                 box = fh.read(8)
                 if len(box) < 8:
-                    return False
+                    # its header is still being written (nothing after 'ftyp' yet): what follows
+                    # will tell, and a reader that waits for it loses nothing
+                    return True
                 size, kind = struct.unpack(">I4s", box)
                 if kind in (b"moov", b"moof"):
                     return True
@@ -192,6 +202,7 @@ class StreamInput:
     def __init__(self, source: str, path: str | None, stall: float | None, idle: float | None = None) -> None:
         self.source, self.stall = source, stall
         self.idle = idle  # a growing file: at its end, wait this long for more before calling it the end
+        self._longest = 0.0  # the longest wait at its end before it grew: how slowly its recorder flushes
         self.interrupted = False  # a signal arrived while FFmpeg read in the main thread
         self._q: queue.Queue = queue.Queue(maxsize=64)
         self._stop = threading.Event()
@@ -220,12 +231,16 @@ class StreamInput:
             os.close(fd)
 
     def _grows(self, fd: int) -> bool:
-        """At the end of a file being written: whether it grows within ``idle`` seconds."""
+        """At the end of a file being written: whether it grows within ``idle`` seconds, or within
+        FLUSH_FACTOR times the longest pause between its growths so far (a recorder that flushes
+        every 5 s outlasted a 5 s --idle-timeout and was taken for finished)."""
         import time
 
         end, waited = os.lseek(fd, 0, os.SEEK_CUR), 0.0
-        while not self._stop.is_set() and waited < self.idle:
+        while not self._stop.is_set() and waited < max(self.idle, FLUSH_FACTOR * self._longest):
             if os.fstat(fd).st_size > end:
+                # the wait is a lower bound of the recorder's pause (not the time we spent reading)
+                self._longest = max(self._longest, waited)
                 return True
             time.sleep(_POLL)
             waited += _POLL
@@ -416,6 +431,34 @@ class VideoReader:
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs
         self.gaps: list[tuple[float, float]] = []  # (time of the frame before, time of the frame after) per jump
+        self._steady = [0, 0.0]  # frame intervals that are no gap: how many, their sum in seconds
+
+    @property
+    def measured_fps(self) -> float | None:
+        """The frames' own rate so far: intervals counted, gaps (frames lost) not; None before two frames."""
+        n, total = self._steady
+        return n / total if n and total > 0 else None
+
+    @property
+    def fps(self) -> float:
+        """The rate to report once the frames are read: the container's, unless the timestamps say
+        otherwise by more than RATE_TOLERANCE (a stream labelled 30 fps whose frames are 0.1 s
+        apart, a 30 fps GIF whose 3-3-4 centisecond delays are read as 33.3 fps)."""
+        got, said = self.measured_fps, float(self.info.fps)
+        return got if got is not None and abs(got - said) > RATE_TOLERANCE * said else said
+
+    def _check_intervals(self, intervals: list[float]) -> None:
+        """Refuse (check_rate) frames whose median spacing is outside the rates wallcli reads,
+        whatever the container says (one frame an hour in a file labelled 30 fps); one tick of
+        the time base either way is the timestamps' rounding (240 fps in milliseconds: 4 or 5)."""
+        if len(intervals) < 2:
+            return
+        m = float(np.median(intervals))
+        tick = float(self._stream.time_base or 0)
+        fastest = 1.0 / max(m - tick, 1e-12)
+        slowest = 1.0 / (m + tick) if m + tick > 0 else math.inf
+        if fastest < MIN_FPS or slowest > MAX_FPS:
+            check_rate(1.0 / m if m > 0 else math.inf, self.source)
 
     def _pick_stream(self, source: str, index: int | None):
         """The video stream to read: ``index`` (--stream N) or the first real one; a file with
@@ -521,6 +564,8 @@ class VideoReader:
 
         recent: deque = deque(maxlen=GAP_HISTORY)
         self.gaps = []
+        self._steady = [0, 0.0]
+        first_intervals: list[float] | None = []  # the first RATE_PROBE, then None (checked)
         size = None  # (width, height) of the first frame: every analysis holds per-pixel state of that size
         try:
             while True:
@@ -545,6 +590,13 @@ class VideoReader:
                             self.gaps.append((round(last_time, 4), round(t, 4)))
                         else:
                             recent.append(dt)
+                            self._steady[0] += 1
+                            self._steady[1] += dt
+                        if first_intervals is not None:
+                            first_intervals.append(dt)
+                            if len(first_intervals) >= RATE_PROBE:
+                                self._check_intervals(first_intervals)
+                                first_intervals = None
                     last_time = t
                     planes = self._turn(frame, frame_planes(frame))
                     if size is None:
@@ -570,6 +622,8 @@ class VideoReader:
                         more = f" and {len(self.gaps) - 3} more" if len(self.gaps) > 3 else ""
                         self._warn(f"{self.source}: frames missing (the timestamps jump): {shown}{more}; "
                                    "what spans a gap is not analysed as continuous (view: 'frame gap')")
+                    if first_intervals is not None:
+                        self._check_intervals(first_intervals)
                     self._check_complete(index, last_time)
                     break
         finally:

@@ -6,6 +6,7 @@ import errno
 import os
 import stat
 import tempfile
+import time
 from contextlib import contextmanager
 from contextvars import ContextVar
 from fractions import Fraction
@@ -93,10 +94,19 @@ def _check_target(out: Path, *, force: bool) -> None:
         raise WallcliError(f"output exists: {out}", hint="use --force to overwrite")
 
 
-def _temporary(out: Path) -> Path:
+# temporaries being written -> an open descriptor holding a lock on each (see _temporary)
+_HELD: dict[str, int] = {}
+SWEEP_AGE = 10.0  # seconds since a leftover temporary was last written
+
+
+def _temporary(out: Path, hold: bool = False) -> Path:
     """Create the empty temporary beside ``out`` that will become it: hidden (scan and editors skip
     it), named after it so a leftover is recognisable, the same suffix (muxers choose the format by
-    it), and never longer than the file system's name limit, however long the output's name."""
+    it), and never longer than the file system's name limit, however long the output's name.
+
+    ``hold``: keep it locked until :func:`_release` (its rename or removal), and first remove the
+    leftovers of earlier runs for the same output that nobody holds: runs killed hard (SIGKILL,
+    a power cut) cannot remove their own, and they piled up beside the outputs."""
     parent = out.parent if str(out.parent) else Path(".")
     suffix = f".tmp{out.suffix}"
     room = name_max(parent) - len(os.fsencode(f"..{suffix}")) - 8  # mkstemp adds 8 random characters
@@ -105,17 +115,76 @@ def _temporary(out: Path) -> Path:
     # cut in bytes (the limit's unit); a character cut in two decodes to surrogates, which encode
     # back to the same bytes
     stem = os.fsdecode(os.fsencode(out.stem)[:max(room, 0)])
+    if hold:
+        _sweep(parent, f".{stem}.", suffix)
     try:
         fd, name = tempfile.mkstemp(prefix=f".{stem}.", suffix=suffix, dir=parent)
-        os.close(fd)
+        if hold and _try_lock(fd):
+            _HELD[name] = fd
+        else:
+            os.close(fd)
     except OSError as exc:
         raise WallcliError(f"cannot create files in {parent}: {_reason(exc)}") from None
     try:
         os.chmod(name, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
     except OSError as exc:
         Path(name).unlink(missing_ok=True)
+        _release([Path(name)])
         raise WallcliError(f"cannot write {out}: {_reason(exc)}") from None
     return Path(name)
+
+
+def _try_lock(fd: int) -> bool:
+    try:
+        import fcntl
+
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return True
+    except (ImportError, OSError):  # not POSIX, a file system without locks, held by another run
+        return False
+
+
+def _sweep(parent: Path, prefix: str, suffix: str) -> None:
+    """Remove ``prefix`` + mkstemp's 8 characters + ``suffix`` files in ``parent`` that no process
+    holds locked: a running wallcli holds its temporaries (a lock dies with its process)."""
+    import glob
+
+    try:
+        import fcntl  # noqa: F401 - without locks nobody's temporaries can be told from leftovers
+    except ImportError:
+        return
+    for name in glob.glob(os.path.join(glob.escape(str(parent)), glob.escape(prefix) + "?" * 8 + glob.escape(suffix))):
+        if name in _HELD:
+            continue
+        try:
+            fd = os.open(name, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+        except OSError:
+            continue
+        try:
+            st = os.fstat(fd)
+            # a few seconds old at least: one just made by mkstemp may not be locked by its run yet
+            if stat.S_ISREG(st.st_mode) and time.time() - st.st_mtime > SWEEP_AGE and _try_lock(fd):
+                os.unlink(name)
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
+
+
+def release_temporary(path: Path) -> None:
+    """Let go of the lock :func:`atomic_path` holds on its temporary, for a caller that locks it
+    itself (flock: two locks of one file conflict even within one process)."""
+    _release([path])
+
+
+def _release(paths: Iterable[Path]) -> None:
+    for p in paths:
+        fd = _HELD.pop(str(p), None)
+        if fd is not None:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
 
 
 # files read together with an input of this suffix: a model's card beside it (wallcli.infer.card)
@@ -216,7 +285,7 @@ def atomic_paths(paths: Iterable, *, force: bool = False) -> Iterator[list[Path]
     try:
         for out in outs:
             _check_target(out, force=force)
-            tmps.append(_temporary(out))
+            tmps.append(_temporary(out, hold=True))
         yield list(tmps)
         raise_if_interrupted()  # a `kill` whose exception Python swallowed still places nothing
     except OSError as exc:
@@ -276,6 +345,7 @@ def _discard(paths: Iterable[Path]) -> None:
             p.unlink(missing_ok=True)
         except OSError:  # clearing up after a failure: the failure is what the user must hear of
             pass
+    _release(paths)
 
 
 def _commit(batches: list) -> None:
@@ -298,6 +368,7 @@ def _commit(batches: list) -> None:
             for tmp, out in zip(batch_tmps, outs):
                 os.replace(tmp, out)
                 placed.append(out)
+        _release(tmps)
     except OSError as exc:
         _discard(tmps)
         _discard(placed)
@@ -346,6 +417,7 @@ class VideoWriter:
         pix_fmt: str | None = None,
         preset: str = "medium",
         repeatable: bool = False,
+        timed: bool = False,
     ):
         """``repeatable``: the same frames always give the same file (the simulator's promise:
         a seed gives one video). Two things in x264 break that by default, both measured here:
@@ -385,29 +457,49 @@ class VideoWriter:
             # or readers guess BT.709 for HD sizes and shift the colours.
             stream.codec_context.colorspace = 6
             stream.codec_context.color_range = 1
+        # write(rgb, t): each frame at its source's time (gaps, variable rates), in ticks of about
+        # 1/90000 s (MPEG's clock) of which a frame at ``fps`` lasts a whole number: a steady
+        # source stays exactly steady (24000/1001 in 1/90000 s ticks read back as 23.9759 fps)
+        self._tick = Fraction(fps.denominator, fps.numerator * max(1, -(-90000 * fps.denominator // fps.numerator)))
+        if timed:
+            stream.codec_context.time_base = stream.time_base = self._tick
         self._stream = stream
         self._av = av
+        self._timed = timed
+        self._last_pts = -1
         self.frames = 0
 
-    def write(self, rgb) -> None:
+    def write(self, rgb, t: float | None = None) -> None:
+        """``t``: the frame's time in seconds (a ``timed`` writer); otherwise frames follow at ``fps``."""
         frame = self._av.VideoFrame.from_ndarray(rgb, format="rgb24")
         frame.pts = None
+        if self._timed and t is not None:
+            # strictly increasing, as muxers require, even where two source times round together
+            frame.pts = self._last_pts = max(round(float(t) / self._tick), self._last_pts + 1)
+            frame.time_base = self._tick
         for packet in self._stream.encode(frame):
             self._container.mux(packet)
         self.frames += 1
 
-    def close(self) -> None:
+    def close(self, drain: bool = True) -> None:
+        """``drain``: encode the frames the encoder still holds (its look-ahead); not after a
+        failure or Ctrl-C, whose output is thrown away: at 6400x4800 that took 17 s."""
         if self._container is None:
             return
         try:
-            for packet in self._stream.encode():
-                self._container.mux(packet)
+            if drain:
+                for packet in self._stream.encode():
+                    self._container.mux(packet)
         finally:
-            self._container.close()
-            self._container = None
+            container, self._container = self._container, None
+            try:
+                container.close()
+            except Exception:  # noqa: BLE001 - after a failure its own error is the one to tell
+                if drain:
+                    raise
 
     def __enter__(self) -> "VideoWriter":
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        self.close(drain=exc_type is None)

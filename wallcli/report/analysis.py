@@ -15,6 +15,7 @@ import os
 import stat
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
+from fractions import Fraction
 from pathlib import Path
 from typing import Any, Callable
 
@@ -111,8 +112,52 @@ def file_facts(source: str) -> dict[str, Any]:
         digest = sha256_file(p)
     except OSError as exc:
         raise WallcliError(f"cannot read {source}: {exc.strerror or exc}") from None
-    return {"size": st.st_size, "sha256": digest, "absolute": str(p.resolve()), "_stat": (st.st_size, st.st_mtime_ns),
-            "modified": datetime.fromtimestamp(st.st_mtime, timezone.utc).isoformat(timespec="seconds")}
+    facts = {"size": st.st_size, "sha256": digest, "absolute": str(p.resolve()), "_stat": (st.st_size, st.st_mtime_ns),
+             "modified": datetime.fromtimestamp(st.st_mtime, timezone.utc).isoformat(timespec="seconds")}
+    media = playlist_media(p)
+    if media is not None:
+        facts["media"] = media
+    return facts
+
+
+PLAYLISTS = (".m3u8", ".m3u")
+MAX_PLAYLIST_DEPTH = 3  # a master playlist names variant playlists, which name the segments
+
+
+def playlist_media(path: Path, depth: int = 0, seen: set | None = None) -> list[dict[str, Any]] | None:
+    """The files a local HLS playlist names (the video is theirs, not the playlist's text), each
+    with its size and sha256, in the playlist's order; None when ``path`` is no playlist. A URL
+    it names is listed unhashed; a file that is missing, with its size and sha256 None."""
+    from wallcli.infer.card import sha256_file
+
+    if path.suffix.lower() not in PLAYLISTS:
+        return None
+    seen = set() if seen is None else seen
+    try:
+        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError:
+        return []
+    out: list[dict[str, Any]] = []
+    for line in (x.strip() for x in lines):
+        if not line or line.startswith("#"):
+            continue
+        if "://" in line:
+            out.append({"path": line, "size": None, "sha256": None})
+            continue
+        target = (path.parent / line).resolve()
+        if target in seen:
+            continue
+        seen.add(target)
+        entry = {"path": str(target), "size": None, "sha256": None}
+        try:
+            if target.is_file():
+                entry.update(size=target.stat().st_size, sha256=sha256_file(target))
+        except OSError:
+            pass
+        out.append(entry)
+        if depth < MAX_PLAYLIST_DEPTH and target.suffix.lower() in PLAYLISTS:
+            out += playlist_media(target, depth + 1, seen) or []
+    return out
 
 
 def load_models(count_model=None, activity_model=None, threads: int = 0) -> dict[str, Any]:
@@ -176,7 +221,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         raise WallcliError(f"{source} has {rows.frames} frame(s); a space-time plot needs at least 2 "
                            "(the temporal mean of one frame is the frame itself)")
     plot = thumb.plot(rows, first.bins, first.fps)
-    plot.meta.update(frame_size=list(rows.frame_size), fps_fraction=f"{info.fps.numerator}/{info.fps.denominator}")
+    rate = info.fps if reader.fps == float(info.fps) else Fraction(reader.fps).limit_denominator(1001)
+    plot.meta.update(frame_size=list(rows.frame_size), fps_fraction=f"{rate.numerator}/{rate.denominator}")
     notes = list(dict.fromkeys([str(w.message) for w in caught] + list(reader.warnings)))
     if tee.snr is not None:
         tee.snr.finish()  # frames still waiting for their corrections' gains
@@ -192,7 +238,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
                 notes.append(f"{source} changed while it was analysed; its size and sha256 are those from before")
         except OSError:
             notes.append(f"{source} disappeared while it was analysed")
-    fps = float(info.fps)
+    fps = reader.fps  # as snr and stplot report it
     identity = {
         "path": str(source), **facts,
         "container": info.container, "codec": info.codec, "pix_fmt": info.pix_fmt,

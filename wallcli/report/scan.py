@@ -68,6 +68,14 @@ def _once_each(records: list[dict[str, Any]], path, problems: list[str]) -> list
     if repeated:
         problems.append(f"{path}: {repeated} video{'s' if repeated != 1 else ''} appear on more than one line; "
                         "the last line of each is counted")
+    # one recording under two names (a hard link, a copy; an older scan scanned both): one video
+    shas = [r.get("sha256") if isinstance(r.get("sha256"), str) and r.get("sha256") else None for r in kept]
+    last_sha = {s: i for i, s in enumerate(shas) if s is not None}
+    twice = len({s for i, s in enumerate(shas) if s is not None and last_sha[s] != i})
+    if twice:
+        problems.append(f"{path}: {twice} recording{'s' if twice != 1 else ''} appear under more than one name "
+                        "(the same sha256); the last line of each is counted")
+        kept = [r for i, (r, s) in enumerate(zip(kept, shas)) if s is None or last_sha[s] == i]
     return kept
 
 

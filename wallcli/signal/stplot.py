@@ -11,6 +11,7 @@ small plot equals removing it from every pixel first.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Callable
 
 import numpy as np
@@ -165,14 +166,17 @@ def compute_stplot(
     if times.n < MIN_FRAMES:
         raise WallcliError(f"{info.source} has {times.n} frame(s); a space-time plot needs at least "
                            f"{MIN_FRAMES} (the temporal mean of one frame is the frame itself)")
+    # the rate the frames' own times run at where they contradict the container's
+    fps = float(getattr(reader, "fps", info.fps))
+    frac = info.fps if fps == float(info.fps) else Fraction(fps).limit_denominator(1001)
     meta = {
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
         "source": str(info.source),
         "frame_size": frame_size,
-        "fps": float(info.fps),
-        "fps_fraction": f"{info.fps.numerator}/{info.fps.denominator}",
-        "fps_source": getattr(info, "fps_source", "container"),
+        "fps": fps,
+        "fps_fraction": f"{frac.numerator}/{frac.denominator}",
+        "fps_source": getattr(info, "fps_source", "container") if fps == float(info.fps) else "timestamps",
         "frames": times.n,
         "roi": list(roi),
         "bins": int(bins),

@@ -268,6 +268,17 @@ def _split_data(recs: list[Recording], pair: list) -> tuple[np.ndarray, np.ndarr
     return np.array(X), np.array([1.0 if r.activity == pair[1] else 0.0 for r in use])
 
 
+def _shard_files(d: Path) -> list[Path]:
+    """The shards the data set's manifest lists (a folder may hold others: an older set's)."""
+    from wallcli.io import jsonfile
+
+    try:
+        manifest = jsonfile.loads((d / "dataset.json").read_text(encoding="utf-8"))
+        return [d / s["file"] for s in manifest["shards"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return sorted(d.glob("shard-*.npz"))
+
+
 def simulated_split_data(data: list[Path], pair: list) -> tuple[np.ndarray, np.ndarray]:
     """The simulator's scenes of the pair in activity datasets ``data``: each scene's windows' mean
     features (a scene is a clip: its windows cut from one rendered room), 1 for the pair's second."""
@@ -278,7 +289,7 @@ def simulated_split_data(data: list[Path], pair: list) -> tuple[np.ndarray, np.n
     want = [CLASSES["activity"].index(c) for c in pair]
     rows: dict[tuple, list] = {}
     for d in data:
-        for f in sorted(Path(d).glob("shard-*.npz")):
+        for f in _shard_files(Path(d)):
             a, meta = load_npz(f)
             lab = np.asarray(a["activity"] if "activity" in a else a["label"])
             keep = np.flatnonzero(np.isin(lab, want) & (np.asarray(a.get("people", np.ones_like(lab))) <= 1))

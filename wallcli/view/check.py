@@ -26,7 +26,7 @@ from wallcli.view.image import (
 from wallcli.view.light import _chroma, _objects, _relative_texture
 from wallcli.view.limits import (
     CHECK_RATE, CLIP_HI, DARK, DENSE, EDGE_LEVEL, FINE, GAP_EDGE, HISTORY, HOLD, HOLD_WITHIN, K_EDGE, K_MOVER, KINDS,
-    MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_REGISTER_SIDE, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
+    MATCH_RATE, MAX_OBJECT_HITS, MAX_SIDE, MIN_CROP, MAX_SPANS, MIN_MOVER_BLOCKS, MIN_REGISTER_SIDE, MIN_SHIFT, MIN_USABLE, NOT_REFUSED, NOTES,
     REL, REL_EDGE,
     SHARP, SIGMA_FLOOR, TEX_TAU,
 )
@@ -129,6 +129,14 @@ class ViewCheck:
         from wallcli.signal.blocks import one_opencv_thread
 
         self.seen += 1
+        if self.roi is not None and min(self.roi[2], self.roi[3]) < MIN_CROP \
+                and tuple(self.roi[2:]) != (planes.width, planes.height):
+            # the images would be the whole frame's (image._crop): what the analysis reads is unchecked
+            if t - self._t_checked >= 1.0 / CHECK_RATE - 1e-3:
+                self._t_checked = t
+                self.frames += 1
+                self._mark("too small to check", t)
+            return
         # these images are too small for OpenCV's pool's hand-offs to pay (blocks.one_opencv_thread)
         with one_opencv_thread():
             cut = None
@@ -322,6 +330,8 @@ class ViewCheck:
                 verdict = _motion_verdict(bands, matches, still, dx, dy)
                 if verdict is None:
                     flags.add("motion not verifiable")
+                    # the shift measured, unverified: max_shift_px 0 read as 'did not move'
+                    self.max_shift = max(self.max_shift, shift)
                 elif verdict:
                     flags.add("camera motion")
                     self.max_shift = max(self.max_shift, shift)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.view.limits import BLOCKS
+from wallcli.view.limits import BLOCKS, MIN_CROP
 
 
 def _shrink(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
@@ -66,7 +66,8 @@ def _crop(a: np.ndarray, roi) -> np.ndarray:
         return a
     x, y, w, h = roi
     c = a[y:y + h, x:x + w]
-    return c if min(c.shape) >= 8 else a  # a bad ROI is the reader's error to give
+    # a bad ROI is the reader's error to give; one too small to look at is ViewCheck's ('too small')
+    return c if min(c.shape) >= MIN_CROP else a
 
 
 def _sampled_luma(planes, roi, max_side: int) -> np.ndarray:

@@ -50,6 +50,7 @@ MIN_SHIFT = 1.5  # source pixels from the reference frame
 # the fewest samples on each side, at the check's scale, that a shift is registered on: a pan of a
 # 30x30 or 8x8 frame passed as still (40x40: caught)
 MIN_REGISTER_SIDE = 33
+MIN_CROP = 8  # an ROI's side under which its images are too small for the check to look at at all
 K_SHIFT = 3.0  # z-score of the shift's fit against its mirror image (see view_motion._shift_fits), held over
 HOLD, HOLD_WITHIN = 3, 8  # agreeing frames among the last few: the phase correlation picks the best
 # of many shifts, so noise alone scores a few, but its peaks land anywhere; on a noisy wall the
@@ -115,7 +116,8 @@ KINDS = {
     "too dark": "much of the frame is too dark",
     "too little usable area": "too little of the frame is usable",
     "too thin to check": "the frame is too thin to check for camera motion",
-    "too small to check": "the frame (or ROI) is too small to check for camera motion",
+    "too small to check": f"the frame (or ROI) is too small to check for camera motion (it needs "
+                          f"{MIN_REGISTER_SIDE}x{MIN_REGISTER_SIDE} pixels or more)",
     # not the view's fault but the file's: frames lost (their timestamps jump, io.video.GAP_FACTOR);
     # nothing spanning it is continuous video
     "frame gap": "frames are missing",

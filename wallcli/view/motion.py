@@ -87,7 +87,11 @@ def _motion_verdict(bands, matches, still: np.ndarray, dx: float, dy: float) -> 
         # registrable if the texture matched the reference (in place or moved by the
         # shift found) well enough at some check: a shaking camera seldom comes back;
         # every band that is must agree, each by SHIFT_Z
+        if shifted is None or match is None:
+            # nothing known to compare here (a high-contrast wall is all edges to the texture):
+            # this band cannot say the camera stayed, and a 15 px pan of one passed as still
+            continue
         if history and max(history) >= REGISTRABLE:
-            agrees = shifted is not None and match is not None and shifted - match > SHIFT_Z
+            agrees = shifted - match > SHIFT_Z
             verdict = agrees if verdict is None else verdict and agrees
     return verdict
