@@ -10,6 +10,8 @@ from wallcli.cli.common import (PNG_NAME, ROI_HELP, check_png_names, corrections
                                 number_option, parse_roi, refuse_view, stall_option, strict_option, stream_option,
                                 threads_option)
 
+from wallcli.cli._classify import IDLE_OPT
+
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 
 
@@ -28,9 +30,7 @@ def track(
     strict: bool = strict_option(),
     follow: bool = typer.Option(False, "--follow", help="Live or growing input: print each track's new samples as "
                                 "JSON Lines as soon as they are found (every 12 s of video), then the whole result."),
-    idle_timeout: float = number_option(5.0, "--idle-timeout", lo=0, hi=1e6,
-                                        help="With --follow on a file: keep reading it as a recorder writes it, "
-                                             "and end when it has not grown for this many seconds."),
+    idle_timeout: float = IDLE_OPT,
     threads: int = threads_option("Decoder threads (0: FFmpeg chooses)."),
     stream: Optional[int] = stream_option(),
     stall_timeout: Optional[float] = stall_option(),
