@@ -1,6 +1,6 @@
 """`wallcli count` on 1080p wall footage against PyAV decode-only, in alternating pairs (issue 36, part 3).
 
-    .venv/bin/python bench/bench_wall_count.py [--seconds 30] [--pairs 5] [--command count]
+    .venv/bin/python bench/bench_wall_count.py [--seconds 30] [--pairs 5] [--command count|activity|snr|stplot|track]
 
 The clip looks like a wall: `wallcli simulate --people 1 --activity walking --seed 11 --size
 1920x1080 --fps 30 --crf 18 --grid 32x32` (made once per length, cached in bench/out/; 30 s takes
@@ -47,7 +47,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seconds", type=int, default=30)
     ap.add_argument("--pairs", type=int, default=5)
-    ap.add_argument("--command", default="count", choices=["count", "activity", "snr", "stplot"])
+    ap.add_argument("--command", default="count", choices=["count", "activity", "snr", "stplot", "track"])
     ap.add_argument("--clip", default="export", choices=["export", "sim"],
                     help="export: a recording upscaled to 1080p at a real export's bitrate (bench/export_clip.py); "
                          "sim: the simulator's 1080p CRF 18 walker (slow to decode)")
