@@ -106,7 +106,7 @@ def test_as_dict_gives_metres_from_the_view_centre():
 # --- the command, on a video made here ---------------------------------------------------------
 
 def _wall(path, seconds=8.0, walker=True, size=(96, 72)):
-    from tests.clips import write_clip
+    from clips import write_clip
 
     w, h = size
     xs = np.arange(w) + 0.5
@@ -217,7 +217,7 @@ def test_a_region_narrower_than_the_bins_reads_no_infinite_darkness(walker_clip,
 
 
 def test_a_plot_file_under_two_seconds_is_too_short(tmp_path, run_cli):
-    from tests.clips import write_plot
+    from clips import write_plot
 
     short = write_plot(tmp_path / "short.npz", seconds=1.0)
     code, out, err = run_cli("track", str(short))

@@ -44,7 +44,7 @@ def test_clip_page_in_a_browser(clip_report, tmp_path):
     dom, console = browser.load(clip_report, tmp_path)
     root = _check_loaded(dom, console)
     imgs = root.find_all("img")
-    assert len(imgs) == 5
+    assert len(imgs) == 6  # frame, heatmap, plots, tracks, two timelines
     for img in imgs:
         want = _png_size(base64.b64decode(img.attrs["src"].split(",", 1)[1]))
         assert img.attrs["data-natural"] == f"{want[0]}x{want[1]}"
