@@ -77,3 +77,23 @@ def write_plot(path: Path, seconds: float = 9.0, fps: float = 30.0, bins: int = 
     save_npz(path, {"horizontal": h, "vertical": v, "time": t},
              {"format": FORMAT, "format_version": 1, "bins": bins, "fps": fps, "roi": [0, 0, 64, 48]})
     return Path(path)
+
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
+
+
+def model_with(tmp_path: Path, **changes) -> Path:
+    """A copy of the shipped count model whose card has ``changes`` (dotted keys: ``two_stage.prior_two_vs_one``)."""
+    import json
+    import shutil
+
+    shutil.copy(MODELS / "count.onnx", tmp_path / "m.onnx")
+    card = json.loads((MODELS / "count.json").read_text())
+    for key, value in changes.items():
+        target = card
+        *parents, leaf = key.split(".")
+        for p in parents:
+            target = target[p]
+        target[leaf] = value
+    (tmp_path / "m.json").write_text(json.dumps(card))
+    return tmp_path / "m.onnx"

@@ -6,11 +6,10 @@ import os
 import subprocess
 import sys
 from fractions import Fraction
-from pathlib import Path
 
 import numpy as np
 import pytest
-from clips import write_clip
+from clips import model_with, write_clip
 
 
 def _wall(i, h=24, w=32):
@@ -172,24 +171,6 @@ def test_snr_predict_gain_below_a_millionth_is_a_usage_error(run_cli):
     assert code == 2 and out == "" and "--gain" in _one_error(err) and "1e-06" in err
 
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
-
-
-def _model_with(tmp_path, **changes) -> Path:
-    import shutil
-
-    shutil.copy(MODELS / "count.onnx", tmp_path / "m.onnx")
-    card = json.loads((MODELS / "count.json").read_text())
-    for key, value in changes.items():
-        target = card
-        *parents, leaf = key.split(".")
-        for p in parents:
-            target = target[p]
-        target[leaf] = value
-    (tmp_path / "m.json").write_text(json.dumps(card))
-    return tmp_path / "m.onnx"
-
-
 @pytest.mark.parametrize("field,value,words", [
     ("two_stage.confidence.thresholds", "x", "thresholds"),
     ("two_stage.confidence.thresholds", [[0]], "thresholds"),
@@ -203,7 +184,7 @@ def test_two_stage_and_class_fields_of_a_card_are_validated_on_load(tmp_path, ru
     from clips import write_plot
 
     plot = write_plot(tmp_path / "p.npz")
-    code, out, err = run_cli("count", plot, "--model", _model_with(tmp_path, **{field: value}), "--json")
+    code, out, err = run_cli("count", plot, "--model", model_with(tmp_path, **{field: value}), "--json")
     assert code == 1 and out == "" and words in _one_error(err)
 
 

@@ -11,11 +11,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from clips import write_clip, write_plot
+from clips import model_with, write_clip, write_plot
 
 from wallcli.cli.common import MAX_THREADS
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
 
 # the clip is 32x24 px: fewer pixels than 64 bins is warned about, and these tests count stderr lines
 FEW_BINS = ("--bins", "16")
@@ -180,17 +179,6 @@ def test_real_full_and_closed_stdout(tmp_path, clip):
 
 
 # 6 ------------------------------------------------------------------------------- model cards
-def _model_with(tmp_path, **changes) -> Path:
-    shutil.copy(MODELS / "count.onnx", tmp_path / "m.onnx")
-    card = json.loads((MODELS / "count.json").read_text())
-    for key, value in changes.items():
-        target = card
-        *parents, leaf = key.split(".")
-        for p in parents:
-            target = target[p]
-        target[leaf] = value
-    (tmp_path / "m.json").write_text(json.dumps(card))
-    return tmp_path / "m.onnx"
 
 
 @pytest.mark.parametrize("field,value", [
@@ -204,7 +192,7 @@ def test_card_fields_are_validated_with_a_message_naming_the_field(tmp_path, fie
     from wallcli.infer.card import read_card
 
     with pytest.raises(WallcliError) as info:
-        read_card(_model_with(tmp_path, **{field: value}))
+        read_card(model_with(tmp_path, **{field: value}))
     assert field.split(".")[-1] in str(info.value)
 
 
@@ -212,7 +200,7 @@ def test_card_nan_is_not_json(tmp_path):
     from wallcli.errors import WallcliError
     from wallcli.infer.card import read_card
 
-    model = _model_with(tmp_path)
+    model = model_with(tmp_path)
     card = model.with_suffix(".json")
     card.write_text(card.read_text().replace('"fps": 30', '"fps": NaN'))
     with pytest.raises(WallcliError, match="NaN"):
@@ -221,11 +209,11 @@ def test_card_nan_is_not_json(tmp_path):
 
 def test_bad_card_through_the_cli_and_new_fields_are_welcome(tmp_path, run_cli):
     plot = write_plot(tmp_path / "p.npz")
-    model = _model_with(tmp_path, fps=0)
+    model = model_with(tmp_path, fps=0)
     code, out, err = run_cli("count", plot, "--model", model, "--json")
     assert code == 1 and out == "" and "'fps'" in _one_error(err)
     # fields a newer model owner adds (a transfer block, anything not read yet) are not refused
-    model = _model_with(tmp_path, transfer={"accuracy": 0.8, "renderer": "other"}, owner_notes={"x": [1, None]})
+    model = model_with(tmp_path, transfer={"accuracy": 0.8, "renderer": "other"}, owner_notes={"x": [1, None]})
     code, out, err = run_cli("count", plot, "--model", model, "--json")
     assert code == 0, err
     assert json.loads(out)["model"]["name"] == "wallcli-count"

@@ -81,8 +81,6 @@ def main() -> None:
         mu, sd, w = logistic(X[tr], (people[tr] == 2).astype(float), a.lam)
         te = (folds == k) & (lab0 >= 1)
         z = np.c_[(X[te] - mu) / sd, np.ones(te.sum())] @ w
-        prior = np.log((people[tr] == 2).mean() / (people[tr] == 1).mean())
-        # the odds against the training folds' share of two (so a clip with no evidence stays as it was)
         new[te] = np.where(z > 0, 2, 1)
     right0 = lab0 == np.array([r.people for r in recs])
     right1 = new == np.array([r.people for r in recs])

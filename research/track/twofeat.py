@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wallcli.signal.track import _smooth, _width, darkness, track_rows, viterbi
+from wallcli.signal.track import _width, darkness, track_rows, viterbi
 
 
 def bandpass(x: np.ndarray, fps: float, lo: float = 0.4, hi: float = 4.0) -> np.ndarray:
