@@ -45,7 +45,7 @@ def track_plot(plot, source: str, *, view_width: float | None = None):
 
         span = f"{t[-1] - t[0]:.2f} s" if len(t) else "no samples"
         raise WallcliError(f"{source} is too short: {len(t)} sample(s), {span}; tracking needs {MIN_SAMPLES / FPS:g} s")
-    fps = float((len(t) - 1) / (t[-1] - t[0])) if len(t) > 1 and t[-1] > t[0] else FPS
+    fps = float((len(t) - 1) / (t[-1] - t[0]))
     extra = {}
     if isinstance((plot.meta or {}).get("view"), dict):
         extra["view"] = plot.meta["view"]
@@ -68,7 +68,12 @@ def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_
                 builder.push(t, row[:BINS])
                 if thumb is not None:
                     thumb.push(t, row)
-        decode.check.fps = float(reader.info.fps or 0.0) or None
+    result = _video_result(str(source), builder, decode, view_width)
+    return result, (thumb.plot(rows, BINS, FPS) if thumb is not None else None)
+
+
+def _video_result(source: str, builder: TrackBuilder, decode, view_width: float | None) -> dict[str, Any]:
+    """The result of a decoded video's rows (WallcliError when too short to track), judged by its view."""
     if builder.samples < MIN_SAMPLES:
         from wallcli.errors import WallcliError
 
@@ -76,10 +81,10 @@ def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_
                            f"{MIN_SAMPLES / FPS:g} s")
     view = decode.check.summary()
     extra = {"view": view, "corrections": decode.unique.corrections(), "duration": round(builder.samples / FPS, 3)}
-    result = track_result(str(source), builder.finish(), fps=FPS, view_width=view_width, extra=extra)
+    result = track_result(source, builder.finish(), fps=FPS, view_width=view_width, extra=extra)
     if not view.get("usable", True):
         result["reason"] = f"view not usable: {view.get('reason')}"
-    return result, (thumb.plot(rows, BINS, FPS) if thumb is not None else None)
+    return result
 
 
 def track_csv(result: dict) -> str:
@@ -96,37 +101,24 @@ def follow_tracks(source: str, *, roi=None, threads: int = 0, view_width: float 
                   corrections: corr.Options = corr.Options()):
     """``--follow``: each track's new samples as soon as a chunk of rows is read (one object per track
     and chunk: ``{"id", "samples"}``), then the whole clip's result (the object of ``--json``)."""
-    from wallcli.errors import WallcliError
     from wallcli.infer.classify import _Decode
     from wallcli.io.video import open_video
 
     builder = TrackBuilder(FPS)
-    said: dict[int, int] = {}
+    said: dict[int, int] = {}  # samples already printed, per track
 
     def news():
         for k in builder.tracks:
             n = said.get(k.id, 0)
             if len(k.t) > n:
-                d = k.as_dict(view_width)
                 said[k.id] = len(k.t)
-                yield {"id": k.id, "samples": d["samples"][n:]}
+                yield {"id": k.id, "samples": k.as_dict(view_width)["samples"][n:]}
 
     with open_video(source, threads=threads) as reader:
         decode = _Decode(_ROWS, reader, roi=roi, corrections=corrections)
         for t, row in decode.rows:
-            n = len(builder.tracks), sum(len(k.t) for k in builder.tracks)
             builder.push(t, row[:BINS])
-            if (len(builder.tracks), sum(len(k.t) for k in builder.tracks)) != n:
-                yield from news()
-    if builder.samples < MIN_SAMPLES:
-        raise WallcliError(f"{source} is too short: {decode.unique.decoded} frame(s) decoded; tracking needs "
-                           f"{MIN_SAMPLES / FPS:g} s")
-    tracks = builder.finish()
+            yield from news()
+    result = _video_result(str(source), builder, decode, view_width)  # finishes the last chunk
     yield from news()
-    view = decode.check.summary()
-    result = track_result(str(source), tracks, fps=FPS, view_width=view_width,
-                          extra={"view": view, "corrections": decode.unique.corrections(),
-                                 "duration": round(builder.samples / FPS, 3)})
-    if not view.get("usable", True):
-        result["reason"] = f"view not usable: {view.get('reason')}"
     yield result

@@ -223,7 +223,8 @@ class TrackBuilder:
             self._rows, self._t = self._rows[-keep:], self._t[-keep:]
 
     def finish(self) -> list[Track]:
-        if len(self._rows) >= max(8, int(MIN_SECONDS * self.fps)) and (not self.tracks or self._t[-1] > self._done_until):
+        # the rows after the last chunk's end (a stream that ended on a chunk's end has none)
+        if len(self._rows) >= max(8, int(MIN_SECONDS * self.fps)) and self._t[-1] > self._done_until:
             self._process(final=True)
         self._rows, self._t = [], []
         return [t for t in self.tracks if t.duration >= MIN_SECONDS - 1.5 / OUT_HZ]
