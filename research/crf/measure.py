@@ -157,9 +157,10 @@ def band_of(people: int, snr_db: float) -> str:
 
 
 def wilson(k: int, n: int):
-    from wallcli.evaluate.score import wilson_ci
+    # evaluate's intervals are exact (Clopper-Pearson) since #54.2; the name stays for the tables' code
+    from wallcli.evaluate.score import exact_ci
 
-    return wilson_ci(k, n)
+    return exact_ci(k, n) if n else (0.0, 1.0)
 
 
 def cell(k: int, n: int) -> str:

@@ -39,7 +39,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import *  # noqa: E402,F403
 from common import CACHE, ROOT, TRANSFER, K, band, mcnemar  # noqa: E402
 from wallcli.infer.twostage import combine  # noqa: E402
-from wallcli.train.folds import wilson  # noqa: E402
+from wallcli.evaluate.score import exact_ci  # noqa: E402
 from wallcli.train.recordings import fold_of, load_recordings  # noqa: E402
 
 BANDS = ("empty", "<0", "0-10", ">=10")
@@ -184,7 +184,7 @@ def row(name, pred, y, bands, det, base_right):
     right = pred == y
     cells = [f"{int(right[bands == b].sum())}" for b in BANDS]
     k, n = int(right[det].sum()), int(det.sum())
-    lo, hi = wilson(k, n)
+    lo, hi = exact_ci(k, n)  # Clopper-Pearson since #54.2 (tables written before it show Wilson's)
     g, l, p = mcnemar(base_right[det], right[det])
     return (f"| {name} | " + " | ".join(cells) + f" | {k} ({100 * k / n:.1f} %, {100 * lo:.0f}-{100 * hi:.0f} %) "
             f"| +{g} -{l}, p = {p:.3g} |"), (k, g, l, p, [int(right[bands == b].sum()) for b in BANDS])

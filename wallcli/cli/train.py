@@ -114,12 +114,17 @@ def train(
       wallcli simulate --dataset 2000 --task count --domain shifted -o data/val
       wallcli train count --data data/count --val data/val --out count.onnx
     """
-    try:
-        import torch  # noqa: F401
-    except ImportError:
+    import importlib.util
+
+    # both before any work: the export at the end needs onnx, and a run that trained for an hour
+    # should not end in an import error
+    missing = [m for m in ("torch", "onnx") if importlib.util.find_spec(m) is None]
+    if missing:
         from wallcli.errors import WallcliError
 
-        raise WallcliError("training needs PyTorch, which is not installed", hint=INSTALL_HINT) from None
+        names = {"torch": "PyTorch", "onnx": "the onnx package"}
+        raise WallcliError(f"training needs {' and '.join(names[m] for m in missing)}, which "
+                           f"{'is' if len(missing) == 1 else 'are'} not installed", hint=INSTALL_HINT)
 
     from wallcli.cli.output import console_err, log
     from wallcli.errors import UsageError
