@@ -22,7 +22,12 @@ import json
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-FOLDERS = ["the recordings (../shared/transfer in the repository's workspace)"]
+FOLDERS = ["the rendered recordings (../shared/transfer in the repository's workspace)"]
+
+
+def rendered(text: str) -> str:
+    """train --clips writes 'labelled recordings' (a user's own footage); the shipped cards' clips are rendered."""
+    return text.replace("labelled recordings", "labelled rendered recordings")
 
 
 def curve_block(task: str) -> dict:
@@ -60,14 +65,15 @@ def main() -> None:
         rec["learning_curve"] = curve_block(task)
         if task == "count":
             assert same_thresholds(card["two_stage"]["confidence"], new["two_stage"]["confidence"])
-            card["two_stage"]["confidence"]["fitted_on"] = new["two_stage"]["confidence"]["fitted_on"]
+            card["two_stage"]["confidence"]["fitted_on"] = rendered(new["two_stage"]["confidence"]["fitted_on"])
         else:
             assert same_thresholds(card["confidence"], new["confidence"])
-            card["confidence"]["fitted_on"] = new["confidence"]["fitted_on"]
-            rec["split_fitted_on"] = ("the first 220 clips (" + card["split"]["fitted_on"] + "); each fold's split "
-                                      "in these figures is refitted on its 4 training folds of the 229")
+            card["confidence"]["fitted_on"] = rendered(new["confidence"]["fitted_on"])
+            rec["split_fitted_on"] = ("t001-t220 (" + card["split"]["fitted_on"] + "); each fold's split in "
+                                      "these figures is refitted on its 4 training folds of all 229 clips")
         card["recordings"] = rec
         card["transfer"] = new["transfer"]
+        card["transfer"]["description"] = rendered(card["transfer"]["description"])
         path.write_text(json.dumps(card, indent=2) + "\n")
         print(task, rec["out_of_fold"]["detectable"]["right"], "of", rec["out_of_fold"]["detectable"]["clips"])
 

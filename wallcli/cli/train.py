@@ -125,6 +125,7 @@ def train(
         names = {"torch": "PyTorch", "onnx": "the onnx package"}
         raise WallcliError(f"training needs {' and '.join(names[m] for m in missing)}, which "
                            f"{'is' if len(missing) == 1 else 'are'} not installed", hint=INSTALL_HINT)
+    import torch
 
     from wallcli.cli.output import console_err, log
     from wallcli.errors import UsageError
