@@ -97,3 +97,20 @@ def model_with(tmp_path: Path, **changes) -> Path:
         target[leaf] = value
     (tmp_path / "m.json").write_text(json.dumps(card))
     return tmp_path / "m.onnx"
+
+
+def grey_wall(i: int, h: int = 24, w: int = 32) -> np.ndarray:
+    """Frame ``i`` of a flat grey wall with a little noise (seeded by the frame index)."""
+    return np.full((h, w, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (h, w, 3))
+
+
+def tiny_clip(path: Path) -> Path:
+    """12 lossless frames of ``grey_wall``: enough for the commands that fail before they decode."""
+    return write_clip(path, grey_wall, 12, fps=30, codec="ffv1", pix_fmt="bgr0", options={})
+
+
+def one_error(err: str) -> str:
+    """The single 'Error: ...' line a bad input must give, with no traceback."""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in err, err
+    return lines[0]

@@ -9,22 +9,16 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from clips import model_with, write_clip
+from clips import grey_wall, model_with, one_error, tiny_clip, write_clip
 
 
-def _wall(i, h=24, w=32):
-    return np.full((h, w, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (h, w, 3))
+_wall = grey_wall
+_one_error = one_error
 
 
 @pytest.fixture
 def clip(tmp_path):
-    return write_clip(tmp_path / "c.mkv", _wall, 12, fps=30, codec="ffv1", pix_fmt="bgr0", options={})
-
-
-def _one_error(err: str) -> str:
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in err, err
-    return lines[0]
+    return tiny_clip(tmp_path / "c.mkv")
 
 
 # 1 ------------------------------------------------------- scan --force keeps the old results

@@ -9,9 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
-from clips import model_with, write_clip, write_plot
+from clips import model_with, one_error, tiny_clip, write_plot
 
 from wallcli.cli.common import MAX_THREADS
 
@@ -20,19 +19,12 @@ from wallcli.cli.common import MAX_THREADS
 FEW_BINS = ("--bins", "16")
 
 
-def _wall(i):
-    return np.full((24, 32, 3), 120.0) + np.random.default_rng(i).normal(0, 1.0, (24, 32, 3))
+_one_error = one_error
 
 
 @pytest.fixture
 def clip(tmp_path):
-    return write_clip(tmp_path / "c.mkv", _wall, 12, fps=30, codec="ffv1", pix_fmt="bgr0", options={})
-
-
-def _one_error(err: str) -> str:
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in err, err
-    return lines[0]
+    return tiny_clip(tmp_path / "c.mkv")
 
 
 def _files(folder: Path) -> set[str]:

@@ -16,9 +16,8 @@ import threading
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
-from clips import write_clip, write_plot
+from clips import one_error, tiny_clip, write_plot
 
 SIM = ["--size", "64x48", "--duration", "10.5", "--fps", "30", "--grid", "16x16", "--crf", "12"]
 WALLCLI = [sys.executable, "-m", "wallcli"]
@@ -39,15 +38,13 @@ def video(tmp_path_factory) -> Path:
 @pytest.fixture
 def clip(tmp_path):
     """A tiny clip for the commands that fail before they decode."""
-    return write_clip(tmp_path / "c.mkv", lambda i: np.full((24, 32, 3), 120.0) + np.random.default_rng(i).normal(
-        0, 1.0, (24, 32, 3)), 12, fps=30, codec="ffv1", pix_fmt="bgr0", options={})
+    return tiny_clip(tmp_path / "c.mkv")
 
 
 def _one_error(err: str) -> str:
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in err, err
-    assert "internal error" not in lines[0], lines[0]  # a clean line says what is wrong
-    return lines[0]
+    line = one_error(err)
+    assert "internal error" not in line, line  # a clean line says what is wrong
+    return line
 
 
 def _copies(folder: Path, video: Path, names) -> Path:
