@@ -189,7 +189,7 @@ def chunk_segments(rows: np.ndarray, times: np.ndarray, fps: float) -> list[dict
             if not seen.all():  # across a short fade the path strays: the place is drawn between its ends
                 i = np.arange(b - a)
                 x = np.interp(i, i[seen], x[seen])
-                w = np.where(seen, w, np.maximum(w, np.abs(np.interp(i, i[seen], x[seen]) - (p + 0.5) / B)))
+                w = np.where(seen, w, np.maximum(w, np.abs(x - (p + 0.5) / B)))  # as far as the path strayed
             out.append({"t": times[a:b], "x": x, "sigma": np.sqrt(w ** 2 + GEOMETRY_SIGMA ** 2),
                         "strength": held[a:b]})
         for t in range(T):  # the next path keeps off this one's whole dip (a broad shade is one person)
