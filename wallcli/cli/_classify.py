@@ -16,7 +16,8 @@ from wallcli.cli.common import (PNG_NAME, ROI_HELP, check_png_names, corrections
 
 INPUT_HELP = "Video (file, http(s)/rtsp URL, '-' for a stream on stdin) or a .npz from 'wallcli stplot'."
 STRIDE_OPT = number_option(None, "--stride", lo=1, hi=65536, integer=True,
-                           help="Frames (at 30 fps) between window starts. Default: the model card's (64).")
+                           help="Frames (at 30 fps) between window starts. Default: the model card's (64, 2.13 s). "
+                                "The last window ends at the clip's end, so its start is off the stride.")
 JSON_OPT = typer.Option(False, "--json", help="Print one JSON object on stdout (see docs/contract.md).")
 PLOT_OPT = typer.Option(None, "--plot", help="Draw class probabilities over time above the space-time plot to this PNG "
                         "(for a video, the plot drawn is averaged down to at most 2048 time columns). " + PNG_NAME)

@@ -32,7 +32,9 @@ def activity(
     """Recognise what a person out of view is doing: none, walking, crouching, waving or jumping.
 
     Both space-time plots (horizontal and vertical) are cut into 256-frame windows (8.5 s at 30 fps, any
-    input frame rate is resampled); the paper's two-branch CNN classifies each (Sharma et al., What
+    input frame rate is resampled), one starting every --stride frames (64: 2.13 s), and a last
+    one that ends where the clip ends, so that its end is read too: a 12 s clip's windows start
+    at 0, 2.13 and 3.47 s. The paper's two-branch CNN classifies each (Sharma et al., What
     You Can Learn by Staring at a Blank Wall, ICCV 2021, supplementary §2); the clip's answer is
     the mean of the window probabilities.
 

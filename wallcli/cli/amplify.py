@@ -71,7 +71,7 @@ def amplify(
     force: bool = typer.Option(False, "--force", help=force_help("OUTPUT")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
-    stall_timeout: Optional[float] = stall_option(),
+    stall_timeout: Optional[float] = stall_option(follow=False),
 ) -> None:
     """Make the invisible visible: a video of the wall's tiny light changes, amplified.
 

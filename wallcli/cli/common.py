@@ -17,7 +17,7 @@ PNG_NAME = "The name must end in .png."
 
 def force_help(what: str) -> str:
     """``--force``'s help, naming what it overwrites (each command writes different files)."""
-    return f"Overwrite {what} if it exists; without --force an existing file is refused before any work starts."
+    return f"Overwrite {what}; without --force, an output file that already exists is refused before any work starts."
 
 # More threads than this only adds contention; 100000 of them once took 16 GB and ignored SIGTERM.
 MAX_THREADS = 4 * (os.cpu_count() or 1)
@@ -134,12 +134,14 @@ def stream_option():
                               "says which was read.")
 
 
-def stall_option():
-    """``--stall-timeout SECONDS``: how long stdin or a FIFO may send nothing."""
+def stall_option(follow: bool = True):
+    """``--stall-timeout SECONDS``: how long stdin or a FIFO may send nothing (``follow``: the
+    command has --follow, whose default differs; the others must not mention it)."""
+    default = "30, or for ever with --follow (a live feed may pause)" if follow else "30"
     return number_option(None, "--stall-timeout", lo=0, hi=1e6,
                          help="Seconds stdin or a pipe may send nothing before the command stops with an "
-                              "error saying it stalled; 0 waits for ever. Default: 30, or for ever with "
-                              "--follow (a live feed may pause). Ctrl-C ends the wait at any time.")
+                              f"error saying it stalled; 0 waits for ever. Default: {default}. "
+                              "Ctrl-C ends the wait at any time.")
 
 
 def use_stream(index, stall: float | None = None, *, live: bool = False) -> None:

@@ -38,7 +38,9 @@ def count(
     sway can still show on a strong signal, and is then counted; see the README).
 
     The space-time plots are cut into 256-frame windows (8.5 s at 30 fps, any input frame
-    rate is resampled). Two stages answer: is anybody moving (the count net, which reads the
+    rate is resampled), one starting every --stride frames (64: 2.13 s), and a last one that
+    ends where the clip ends, so that its end is read too: a 12 s clip's windows start at
+    0, 2.13 and 3.47 s. Two stages answer: is anybody moving (the count net, which reads the
     horizontal plot as the paper's does, and the activity net, which reads both plots, as two
     detectors), then one or two (the count net). The clip's answer combines each net's mean
     window probabilities; the JSON's "stages" says what each stage found. --single-stage

@@ -29,7 +29,7 @@ def evaluate(
                                              "clips whose SNR in dB (labels.csv's snr_db, else the answer's measured "
                                              "signal, signal_db) is at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
-    force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG, the only file evaluate writes,")),
+    force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG (the only file evaluate writes)")),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),

@@ -34,7 +34,7 @@ def report(
     force: bool = typer.Option(False, "--force", help=force_help("the -o file")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
-    stall_timeout: Optional[float] = stall_option(),
+    stall_timeout: Optional[float] = stall_option(follow=False),
     strict: bool = strict_option(),
     no_deflicker: bool = deflicker_option(),
     no_exposure: bool = exposure_option(),

@@ -27,7 +27,7 @@ def stplot(
     force: bool = typer.Option(False, "--force", help=force_help("the -o and --png files")),
     threads: int = threads_option(THREADS_HELP),
     stream: Optional[int] = stream_option(),
-    stall_timeout: Optional[float] = stall_option(),
+    stall_timeout: Optional[float] = stall_option(follow=False),
 ) -> None:
     """Compute space-time plots: the wall, mean-removed and averaged over rows (horizontal plot,
     64 positions x time x RGB) and over columns (vertical plot).

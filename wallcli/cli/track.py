@@ -29,7 +29,8 @@ def track(
     force: bool = typer.Option(False, "--force", help=force_help("the --csv and --png files")),
     strict: bool = strict_option(),
     follow: bool = typer.Option(False, "--follow", help="Live or growing input: print each track's new samples as "
-                                "JSON Lines as soon as they are found (every 12 s of video), then the whole result."),
+                                "JSON Lines as soon as they are found (the video is read in 16 s chunks, one every 12 s: "
+                                "chunks overlap by 4 s), then the whole result."),
     idle_timeout: float = IDLE_OPT,
     threads: int = threads_option("Decoder threads (0: FFmpeg chooses)."),
     stream: Optional[int] = stream_option(),
@@ -47,8 +48,8 @@ def track(
     x is where the shade is, which the light's direction sets: it can lead or trail the
     person, and a window beside the wall mirrors it. On the rendered recordings'
     motion-capture truth the longest track of a single walker follows the person (Pearson
-    r >= 0.8) on about half the clips; see research/track/README.md before reading x as a
-    person's place.
+    r >= 0.8) on 17 of the 28 clips (61 %); see research/track/README.md before reading x as
+    a person's place.
 
     \b
     Examples:

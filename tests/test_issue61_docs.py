@@ -1,0 +1,66 @@
+"""Issue 61, points 9-14: help and docs say what the tool does (each test failed on the old text)."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _help(run_cli, command: str) -> str:
+    code, out, err = run_cli(command, "--help")
+    assert code == 0, err
+    return " ".join(out.split())  # the help is wrapped to the terminal: compare words, not lines
+
+
+# 9 ------------------------------------------------------------ help that contradicts the tool
+def test_track_help_gives_the_measured_rate_not_about_half(run_cli):
+    text = _help(run_cli, "track")
+    assert "about half" not in text
+    assert "17 of the 28" in text and "61 %" in text
+    # the README and research/track/README.md quote the same figure
+    assert "61 %" in (ROOT / "README.md").read_text()
+    assert "17 of 28 (61 %)" in (ROOT / "research" / "track" / "README.md").read_text()
+
+
+def test_track_follow_help_names_the_16_s_chunks_and_their_12_s_step(run_cli):
+    from wallcli.signal.track import CHUNK_SECONDS, OVERLAP_SECONDS
+
+    text = _help(run_cli, "track")
+    assert f"{CHUNK_SECONDS:g} s chunks, one every {CHUNK_SECONDS - OVERLAP_SECONDS:g} s" in text
+
+
+@pytest.mark.parametrize("command", ["stplot", "snr", "amplify", "report"])
+def test_stall_timeout_help_does_not_mention_a_follow_the_command_lacks(run_cli, command):
+    text = _help(run_cli, command)
+    assert "--stall-timeout" in text and "--follow" not in text
+
+
+@pytest.mark.parametrize("command", ["count", "activity", "track"])
+def test_stall_timeout_help_keeps_the_follow_default_where_follow_exists(run_cli, command):
+    assert "for ever with --follow" in _help(run_cli, command)
+
+
+@pytest.mark.parametrize("command", ["stplot", "snr", "amplify", "report", "count", "activity", "track",
+                                     "evaluate", "simulate", "train"])
+def test_force_help_reads_as_english(run_cli, command):
+    text = _help(run_cli, command)
+    assert "--force" in text
+    assert "files if it exists" not in text and ",;" not in text and ", if it exists" not in text
+
+
+@pytest.mark.parametrize("command", ["count", "activity"])
+def test_window_starts_are_explained_where_the_user_reads_them(run_cli, tmp_path, command):
+    text = _help(run_cli, command)
+    assert "0, 2.13 and 3.47 s" in text  # what the table of a 12 s clip shows, explained beside it
+    assert "ends where the clip ends" in text
+
+
+def test_a_12_s_clip_has_the_window_starts_the_help_quotes():
+    from wallcli.signal.window import window_starts
+
+    fps_frames = 360  # 12 s at 30 fps, as examples/walking.mp4
+    starts = [round(s / 30, 2) for s in window_starts(fps_frames, 256, 64)]
+    assert starts == [0.0, 2.13, 3.47]
