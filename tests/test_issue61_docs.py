@@ -64,3 +64,27 @@ def test_a_12_s_clip_has_the_window_starts_the_help_quotes():
     fps_frames = 360  # 12 s at 30 fps, as examples/walking.mp4
     starts = [round(s / 30, 2) for s in window_starts(fps_frames, 256, 64)]
     assert starts == [0.0, 2.13, 3.47]
+
+
+# 10 ----------------------------------------------------------------------- docs/models.md
+def _sections(path: Path) -> list[tuple[str, str]]:
+    """(heading, the text up to the next heading) of each heading of a Markdown page."""
+    out, head, body = [], None, []
+    for line in path.read_text().splitlines():
+        if line.startswith("#"):
+            if head is not None:
+                out.append((head, "\n".join(body)))
+            head, body = line, []
+        else:
+            body.append(line)
+    out.append((head, "\n".join(body)))
+    return out
+
+
+def test_models_doc_has_no_empty_heading_and_no_loose_parenthesis():
+    for head, body in _sections(ROOT / "docs" / "models.md"):
+        paragraphs = [p.strip() for p in body.split("\n\n") if p.strip()]
+        assert paragraphs, f"empty section: {head}"
+        # a section that opens with an aside in brackets is an aside to a table that is not there
+        assert not paragraphs[0].startswith("("), head
+    assert "count 10 and 26" not in (ROOT / "docs" / "models.md").read_text()
