@@ -12,10 +12,8 @@ the queue, whatever the video's length.
 
 from __future__ import annotations
 
-import math
 import os
 import queue
-import re
 import threading
 import warnings
 from contextvars import ContextVar
@@ -24,15 +22,18 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Iterator
 
-import numpy as np
-
 from wallcli.errors import WallcliError
 # the planes a frame decodes to (importable from here too, as before the split)
 from wallcli.io.planes import Planes, frame_planes, quarter_turns, rotate_planes  # noqa: F401
+# byte streams, what an input is, and frame rates and times live beside this file; their names
+# stay importable from here, where callers have always found them
+from wallcli.io.byte_stream import FLUSH_FACTOR, StreamInput, _byte_stream, _front_to_back, _Stopped  # noqa: F401
+from wallcli.io.rates import (GAP_FACTOR, GAP_HISTORY, GAP_MIN, MAX_FPS, MIN_FPS, RATE_PROBE,  # noqa: F401
+                              RATE_TOLERANCE, RAW_DEFAULT_FPS, RAW_DEMUXERS, FrameClock, check_rate,
+                              container_rate)
+from wallcli.io.sources import (REENCODED, STDIN_MP4, NotAVideo, _describe_open_error, _is_url,  # noqa: F401
+                                _real_video)
 
-STDIN_MP4 = ("-: an MP4 cannot be streamed on stdin (its index is at the end of the file, where a pipe "
-             "cannot seek); give its path, or stream MPEG-TS, Matroska, NUT or Y4M "
-             "(ffmpeg -i clip.mp4 -c copy -f mpegts -)")
 
 # The video stream to read (its index in the file, as ffprobe numbers them), for commands given
 # --stream N (cli.common.use_stream); None: the first real video stream
@@ -42,32 +43,12 @@ STREAM: ContextVar[int | None] = ContextVar("wallcli_stream", default=None)
 # for commands given --stall-timeout (cli.common.use_stream); None: wait for ever (a live feed)
 DEFAULT_STALL = 30.0
 STALL: ContextVar[float | None] = ContextVar("wallcli_stall", default=DEFAULT_STALL)
-_POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal ends it within this)
 # --follow on a regular file: read it as it grows, until it has not grown for this many seconds
 # (None: read what is there, as any file)
 FOLLOW_IDLE: ContextVar[float | None] = ContextVar("wallcli_follow_idle", default=None)
-FLUSH_FACTOR = 3.0  # a followed file ends after this many of its longest waits for growth, if longer
 
 
 _QUEUE_SIZE = 8
-
-# The frame rates wallcli reads. The models see 8.5 s windows resampled to 30 fps, trained on 15-60 fps
-# videos, and the SNR estimator (paper suppl. 3.2) takes what lasts from one frame to the next as
-# signal: far below 10 fps a person moves across the wall between two frames and both would be
-# answering about interpolated samples (a 0.5 fps file gave eight windows and 32 dB, snr -99 dB);
-# far above 240 fps, the timestamps of slow-motion files are rarely the capture's.
-MIN_FPS, MAX_FPS = 10.0, 240.0
-# The frame intervals whose median the rate check reads (the rest of a file is checked by then), and
-# how far the frames' measured rate may stray from the container's before it is the one reported
-RATE_PROBE = 16
-RATE_TOLERANCE = 0.02
-
-
-def check_rate(fps: float, source: str) -> None:
-    """Refuse a frame rate outside MIN_FPS-MAX_FPS: one line, the same for every command."""
-    if not (MIN_FPS <= float(fps) <= MAX_FPS):
-        raise WallcliError(f"{source}: {float(fps):.3g} fps; wallcli reads videos of {MIN_FPS:g} to {MAX_FPS:g} fps "
-                           "(the models' windows and the SNR estimator assume frames a fraction of a second apart)")
 
 
 @dataclass
@@ -93,221 +74,6 @@ class Frame:
     planes: Planes
     _keep: object = field(default=None, repr=False)  # the av.VideoFrame whose buffers the planes view
     gap: float = 0.0  # seconds since the frame before, when the timestamps jump there (frames lost): 0 otherwise
-
-
-# A jump of the timestamps over GAP_FACTOR typical frame intervals, and over GAP_MIN seconds, is frames
-# lost (corruption, a dropped stretch of a stream), not a variable frame rate's slower frame (phones:
-# up to about 2x; a few frames' pause is interpolated over like any resampling)
-GAP_FACTOR = 5.0
-GAP_MIN = 0.25
-GAP_HISTORY = 16  # recent intervals whose median is the typical one
-
-# FFmpeg's demuxers of bare elementary streams: no timestamps, and an average_rate that is only
-# the demuxer's -framerate default (25), whatever the frames are; the codec's headers (H.264's
-# VUI timing, MPEG-2's sequence header) are what knows the rate
-RAW_DEMUXERS = frozenset({"h264", "hevc", "vvc", "m4v", "mpegvideo", "cavsvideo", "avs2", "avs3", "vc1", "dirac",
-                          "mjpeg", "dnxhd"})
-RAW_DEFAULT_FPS = 25  # what FFmpeg assumes for such a stream that states no rate
-
-# Lossy legacy codecs that ffmpeg writes by default to a pipe (NUT and AVI: MPEG-4 Part 2; MPEG-TS:
-# MPEG-2) or on a plain -c mjpeg, and that no current camera streams: on stdin they mean the
-# camera's stream was re-encoded (`-f nut -` without `-c copy`), which changes the faint wall
-# signal and so the answers (examples/walking.mp4 through `-f nut` answers otherwise than the file)
-REENCODED = {"mpeg4": "MPEG-4 Part 2", "msmpeg4v1": "MS MPEG-4 v1", "msmpeg4v2": "MS MPEG-4 v2",
-             "msmpeg4": "MS MPEG-4 v3", "mjpeg": "Motion JPEG", "mpeg1video": "MPEG-1", "mpeg2video": "MPEG-2"}
-
-
-def _real_video(stream) -> bool:
-    """A stream of moving pictures that FFmpeg can decode, not a cover picture or a thumbnail track."""
-    d = getattr(stream, "disposition", None)
-    try:
-        still = bool(d & (d.__class__.attached_pic | d.__class__.timed_thumbnails | d.__class__.still_image))
-    except (AttributeError, TypeError):
-        still = False
-    return not still and stream.codec_context is not None
-
-
-class NotAVideo(WallcliError):
-    """FFmpeg opened the input but found no video in it (a text file, a CSV, a cut header): a
-    command that reads something else too (``wallcli report``) can say what it accepts.
-    ``detail``: what was found, without the input's name ("FFmpeg: Invalid data found ...")."""
-
-    def __init__(self, message: str, detail: str = ""):  # a default: unpickled (a scan worker) from args
-        super().__init__(message)
-        self.detail = detail or message
-
-
-def _describe_open_error(source: str, exc: Exception) -> WallcliError:
-    text = str(exc).replace(": '<none>'", "")  # (PyAV's name for a stream it reads from Python)
-    if isinstance(exc, FileNotFoundError) or "No such file" in text:
-        return WallcliError(f"no such file: {source}")
-    if "Permission denied" in text:
-        return WallcliError(f"cannot read {source}: permission denied")
-    # FFmpeg's own words, without PyAV's "[Errno 1094995529] ...: 'path'" around them (an AVERROR
-    # tag read as a number, and the path the line already names)
-    why = getattr(exc, "strerror", None) or text.strip() or type(exc).__name__
-    return NotAVideo(f"{source} is not a readable video (FFmpeg: {why})", f"FFmpeg: {why}")
-
-
-def _is_url(source: str) -> bool:
-    return re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*://", source) is not None
-
-
-class _Stopped(Exception):
-    """The read was stopped (the reader closed, or a signal in the main thread): an Exception, so
-    that PyAV hands it back where FFmpeg returns instead of dropping it."""
-
-
-def _front_to_back(path: str) -> bool:
-    """Whether a file can be read as a stream, front to back (what reading it as it grows needs):
-    not an MP4/MOV whose index (moov) comes after its media (mdat), as most recorders write it
-    when they finish; a fragmented or 'faststart' MP4 and MPEG-TS, MKV, raw streams can."""
-    import struct
-
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(8)
-            if len(head) < 8 or head[4:8] != b"ftyp":
-                return True
-            fh.seek(0)
-            for _ in range(64):
-                box = fh.read(8)
-                if len(box) < 8:
-                    # its header is still being written (nothing after 'ftyp' yet): what follows
-                    # will tell, and a reader that waits for it loses nothing
-                    return True
-                size, kind = struct.unpack(">I4s", box)
-                if kind in (b"moov", b"moof"):
-                    return True
-                if kind == b"mdat":
-                    return False
-                if size == 1:
-                    size = struct.unpack(">Q", fh.read(8))[0] - 8
-                elif size == 0:
-                    return False
-                fh.seek(size - 8, os.SEEK_CUR)
-    except (OSError, struct.error):
-        return True
-    return False
-
-
-class StreamInput:
-    """A byte stream (stdin, a FIFO) read by a thread of ours and handed to FFmpeg as a Python file.
-
-    FFmpeg's own read() of a pipe blocks in C, where neither Ctrl-C, SIGTERM nor the decoder's stop
-    reach it (a stalled writer held wallcli for as long as it stalled); here every wait is in
-    Python, in steps of _POLL, and fails with one line after ``stall`` seconds without data. Memory:
-    at most 64 chunks of 64 KiB queued."""
-
-    def __init__(self, source: str, path: str | None, stall: float | None, idle: float | None = None) -> None:
-        self.source, self.stall = source, stall
-        self.idle = idle  # a growing file: at its end, wait this long for more before calling it the end
-        self._longest = 0.0  # the longest wait at its end before it grew: how slowly its recorder flushes
-        self.interrupted = False  # a signal arrived while FFmpeg read in the main thread
-        self._q: queue.Queue = queue.Queue(maxsize=64)
-        self._stop = threading.Event()
-        self._buf = b""
-        self._done = False  # EOF given, or the read failed once (FFmpeg may ask again: say EOF)
-        threading.Thread(target=self._pump, args=(path,), daemon=True, name="wallcli-input").start()
-
-    def _pump(self, path: str | None) -> None:
-        # (opening a FIFO blocks until its writer opens it: here, not in the main thread). The
-        # thread may stay in os.read when the command ends: a daemon, holding nothing of FFmpeg's.
-        try:
-            fd = os.dup(0) if path is None else os.open(path, os.O_RDONLY)
-        except OSError as exc:
-            return self._put(exc)
-        try:
-            while not self._stop.is_set():
-                chunk = os.read(fd, 1 << 16)
-                if not chunk and self.idle is not None and self._grows(fd):
-                    continue
-                self._put(chunk)
-                if not chunk:
-                    break
-        except OSError as exc:
-            self._put(exc)
-        finally:
-            os.close(fd)
-
-    def _grows(self, fd: int) -> bool:
-        """At the end of a file being written: whether it grows within ``idle`` seconds, or within
-        FLUSH_FACTOR times the longest pause between its growths so far (a recorder that flushes
-        every 5 s outlasted a 5 s --idle-timeout and was taken for finished)."""
-        import time
-
-        end, waited = os.lseek(fd, 0, os.SEEK_CUR), 0.0
-        while not self._stop.is_set() and waited < max(self.idle, FLUSH_FACTOR * self._longest):
-            if os.fstat(fd).st_size > end:
-                # the wait is a lower bound of the recorder's pause (not the time we spent reading)
-                self._longest = max(self._longest, waited)
-                return True
-            time.sleep(_POLL)
-            waited += _POLL
-        return False
-
-    def _put(self, item) -> None:
-        while not self._stop.is_set():
-            try:
-                return self._q.put(item, timeout=_POLL)
-            except queue.Full:
-                pass
-
-    def read(self, n: int) -> bytes:
-        try:
-            return self._read(int(n))
-        except KeyboardInterrupt:  # the signal handler's raise, inside FFmpeg's call of read()
-            self.interrupted = True
-            self._done = True
-            raise _Stopped("interrupted") from None
-        except BaseException:
-            self._done = True
-            raise
-
-    def _read(self, n: int) -> bytes:
-        if not self._buf:
-            if self._done:
-                return b""
-            import time
-
-            waited = 0.0
-            while True:
-                if self._stop.is_set():
-                    raise _Stopped("stopped")
-                t = time.monotonic()
-                try:
-                    item = self._q.get(timeout=_POLL)
-                    break
-                except queue.Empty:
-                    waited += time.monotonic() - t
-                    if self.stall is not None and waited >= self.stall:
-                        raise WallcliError(f"{self.source}: no data for {self.stall:g} s (its writer stalled)",
-                                           hint="--stall-timeout SECONDS waits longer; 0, for ever")
-            if isinstance(item, OSError):
-                raise WallcliError(f"cannot read {self.source}: {item.strerror or item}")
-            if not item:
-                self._done = True
-                return b""
-            self._buf = item
-        out, self._buf = self._buf[:n], self._buf[n:]
-        return out
-
-    def close(self) -> None:
-        self._stop.set()
-
-
-def _byte_stream(source: str) -> bool:
-    """A path that is a pipe, socket or character device (not a camera): read as a stream."""
-    import stat
-
-    if source.startswith("/dev/video"):
-        return False
-    try:
-        mode = os.stat(source).st_mode
-    except OSError:
-        return False
-    return stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode) or stat.S_ISCHR(mode)
-
 
 class VideoReader:
     """Open with :func:`open_video`; iterate :meth:`frames` once (decode once, stream)."""
@@ -371,30 +137,10 @@ class VideoReader:
         stream.thread_type = "AUTO"  # frame + slice threads: most of our time is decode
         stream.codec_context.thread_count = int(threads)
         self._stream = stream
-        fps_source = "container"
         container_name = str(self._container.format.name or "")
-        raw = container_name in RAW_DEMUXERS
-        rate = None if raw else stream.average_rate
-        if raw:
-            stated = stream.codec_context.framerate
-            if stated and stated > 0:
-                rate, fps_source = stated, "codec"
-                self.warnings.append(f"{source}: a bare {container_name} stream has no timestamps; read at "
-                                     f"{float(stated):.4g} fps, the rate its codec headers state")
-            else:
-                rate, fps_source = Fraction(RAW_DEFAULT_FPS), "assumed"
-                self._warn(f"{source}: a bare {container_name} stream states no frame rate; assuming "
-                           f"{RAW_DEFAULT_FPS} fps (FFmpeg's default): times and rates are wrong if it is not")
-        rate = rate or stream.guessed_rate or stream.base_rate
-        if not rate or rate <= 0:
-            rate, fps_source = Fraction(30), "assumed"
-            self.warnings.append(f"{source}: no frame rate in the stream; assuming 30 fps")
-        fps = Fraction(rate).limit_denominator(1001)
         try:
-            # the measured or stated rate only: a container that gives none leaves FFmpeg guessing
-            # from its time base (Matroska's 1000), which says nothing of the frames
-            if stream.average_rate or fps_source == "codec":
-                check_rate(fps, source)
+            fps, fps_source = container_rate(stream, container_name, source,
+                                             lambda m, loud: self._warn(m) if loud else self.warnings.append(m))
         except WallcliError:
             self._container.close()
             raise
@@ -430,14 +176,17 @@ class VideoReader:
         self._peek_rotation(target, fmt, options)
         self._used = False
         self._worker = None  # (thread, queue, stop event) while frames() runs
-        self.gaps: list[tuple[float, float]] = []  # (time of the frame before, time of the frame after) per jump
-        self._steady = [0, 0.0]  # frame intervals that are no gap: how many, their sum in seconds
+        self._clock = FrameClock(stream.time_base, fps, source)  # frame times, gaps and measured rate
+
+    @property
+    def gaps(self) -> list[tuple[float, float]]:
+        """(time of the frame before, time of the frame after) per jump of the timestamps (frames lost)."""
+        return self._clock.gaps
 
     @property
     def measured_fps(self) -> float | None:
         """The frames' own rate so far: intervals counted, gaps (frames lost) not; None before two frames."""
-        n, total = self._steady
-        return n / total if n and total > 0 else None
+        return self._clock.measured_fps
 
     @property
     def fps(self) -> float:
@@ -446,19 +195,6 @@ class VideoReader:
         apart, a 30 fps GIF whose 3-3-4 centisecond delays are read as 33.3 fps)."""
         got, said = self.measured_fps, float(self.info.fps)
         return got if got is not None and abs(got - said) > RATE_TOLERANCE * said else said
-
-    def _check_intervals(self, intervals: list[float]) -> None:
-        """Refuse (check_rate) frames whose median spacing is outside the rates wallcli reads,
-        whatever the container says (one frame an hour in a file labelled 30 fps); one tick of
-        the time base either way is the timestamps' rounding (240 fps in milliseconds: 4 or 5)."""
-        if len(intervals) < 2:
-            return
-        m = float(np.median(intervals))
-        tick = float(self._stream.time_base or 0)
-        fastest = 1.0 / max(m - tick, 1e-12)
-        slowest = 1.0 / (m + tick) if m + tick > 0 else math.inf
-        if fastest < MIN_FPS or slowest > MAX_FPS:
-            check_rate(1.0 / m if m > 0 else math.inf, self.source)
 
     def _pick_stream(self, source: str, index: int | None):
         """The video stream to read: ``index`` (--stream N) or the first real one; a file with
@@ -556,48 +292,14 @@ class VideoReader:
         self._worker = (worker, q, stop)
         worker.start()
         index = 0
-        first_pts = None
-        last_time = -np.inf
-        tb = self._stream.time_base
-        fps = float(self.info.fps)
-        from collections import deque
-
-        recent: deque = deque(maxlen=GAP_HISTORY)
-        self.gaps = []
-        self._steady = [0, 0.0]
-        first_intervals: list[float] | None = []  # the first RATE_PROBE, then None (checked)
+        clock = self._clock = FrameClock(self._stream.time_base, self.info.fps, self.source)
         size = None  # (width, height) of the first frame: every analysis holds per-pixel state of that size
         try:
             while True:
                 kind, item = q.get()
                 if kind == "frame":
                     frame = item
-                    if frame.pts is not None and tb is not None:
-                        if first_pts is None:
-                            first_pts = frame.pts
-                        t = float((frame.pts - first_pts) * tb)
-                    else:
-                        t = index / fps
-                    if t <= last_time:
-                        # Duplicate or out-of-order timestamps (broken muxers): keep time monotonic.
-                        t = last_time + 1.0 / fps
-                    gap = 0.0
-                    if index:
-                        dt = t - last_time
-                        typical = float(np.median(recent)) if len(recent) >= 4 else 1.0 / fps
-                        if dt > GAP_FACTOR * typical and dt > max(GAP_FACTOR / fps, GAP_MIN):
-                            gap = dt
-                            self.gaps.append((round(last_time, 4), round(t, 4)))
-                        else:
-                            recent.append(dt)
-                            self._steady[0] += 1
-                            self._steady[1] += dt
-                        if first_intervals is not None:
-                            first_intervals.append(dt)
-                            if len(first_intervals) >= RATE_PROBE:
-                                self._check_intervals(first_intervals)
-                                first_intervals = None
-                    last_time = t
+                    t, gap = clock.stamp(frame.pts, index)
                     planes = self._turn(frame, frame_planes(frame))
                     if size is None:
                         size = (planes.width, planes.height)
@@ -622,9 +324,8 @@ class VideoReader:
                         more = f" and {len(self.gaps) - 3} more" if len(self.gaps) > 3 else ""
                         self._warn(f"{self.source}: frames missing (the timestamps jump): {shown}{more}; "
                                    "what spans a gap is not analysed as continuous (view: 'frame gap')")
-                    if first_intervals is not None:
-                        self._check_intervals(first_intervals)
-                    self._check_complete(index, last_time)
+                    clock.check_intervals()
+                    self._check_complete(index, clock.last_time)
                     break
         finally:
             self._stop_worker()
