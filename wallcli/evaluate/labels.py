@@ -8,6 +8,10 @@ of its ``activities`` other than ``none`` (what tests/test_examples.py checks th
 against). A labels.csv that cannot be read is a failure of the whole run (exit 1, naming the line);
 a clip that is missing is not: it becomes that clip's error row. A sidecar is one clip's labels, so
 a damaged one (beside its video) skips that clip, with the reason, rather than failing the run.
+Every clip must lie inside the folder once links are resolved (a name relative to it, or an
+absolute path into it): one that leads out of it (``../x.mp4``, ``/dev/zero``) fails the run,
+naming its row, as does one that is not a regular file (a FIFO would block the run), and a
+labels.csv that is not a regular file is refused as such.
 Two names for one file (``a.mp4``, ``./a.mp4``, a hard link or symlink to it) are one clip listed
 twice: an error, as any duplicate is, since scoring it twice would weigh it double; so are two
 byte-identical copies. A sidecar without ``activities`` gives the count's truth from ``moving``
@@ -35,7 +39,7 @@ MAX_LINE = 64 * 1024
 
 @dataclass(frozen=True)
 class Clip:
-    file: str  # as the labels name it (relative to the folder, or absolute)
+    file: str  # as the labels name it (relative to the folder, or an absolute path into it)
     path: Path
     people: int  # moving people
     activity: str
@@ -69,12 +73,45 @@ def read_labels(folder: str | Path) -> Labels:
     if (d / LABELS).is_file():
         clips, has_snr = _from_csv(d)
         return Labels(clips, LABELS, has_snr, files=[d / LABELS])
+    if os.path.lexists(d / LABELS):  # a device, a FIFO, a folder or a broken link: there, but not labels
+        raise WallcliError(f"{d / LABELS} is not a regular file ({_kind(d / LABELS)}); labels.csv must be "
+                           "a text file of one row per clip")
     clips, damaged = _from_sidecars(d)
     if not clips:
         why = f" ({len(damaged)} damaged: {damaged[0][1]})" if damaged else ""
         raise WallcliError(f"{folder} has no labels: looked for {LABELS} (columns {', '.join(REQUIRED)}) and for "
                            f"*.json sidecars with 'people' and 'activity' (as 'wallcli simulate' writes them){why}")
     return Labels(clips, "sidecars", False, damaged, files=sorted(d.glob("*.json")))
+
+
+def _inside(d: Path, named: list[tuple[str, Clip]], source: Path | None = None) -> None:
+    """Fail on an entry whose clip is not inside the folder once links are resolved (``../x.mp4``,
+    ``/dev/zero``, an absolute path elsewhere, a symlink out): labels describe the clips beside
+    them, and a labels file handed over with a folder must not make evaluate or train read
+    whatever else the machine holds."""
+    root = d.resolve()
+    for where, c in named:
+        row = f"{source} {where}" if source else f"{d / where}"
+        try:
+            target = c.path.resolve()
+        except (OSError, RuntimeError, ValueError) as exc:  # a link loop, a NUL in the name
+            raise WallcliError(f"{row} names {c.file!r}, which cannot be resolved ({exc})") from None
+        if not target.is_relative_to(root):
+            raise WallcliError(f"{row} names {c.file!r}, which is outside {d} (it leads to {target}); "
+                               "put the clip itself (not a link to it) in the folder")
+        if target.exists() and not target.is_file():  # reading a FIFO or a device would block or never end
+            raise WallcliError(f"{row} names {c.file!r}, which is {_kind(target)}, not a video file")
+
+
+def _kind(path: Path) -> str:
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return "a broken link"
+    return ("a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else "a folder" if stat.S_ISDIR(mode) else "a socket" if stat.S_ISSOCK(mode) else "not a file")
 
 
 def _no_duplicates(source: Path, named: list[tuple[str, Clip]]) -> None:
@@ -143,6 +180,7 @@ def _from_csv(d: Path) -> tuple[list[Clip], bool]:
         raise WallcliError(f"cannot read {path}: {exc}") from None
     if not named:
         raise WallcliError(f"{path} lists no clips")
+    _inside(d, named, path)
     _no_duplicates(path, named)
     return [c for _, c in named], has_snr
 
@@ -212,6 +250,7 @@ def _from_sidecars(d: Path) -> tuple[list[Clip], list[tuple[str, str]]]:
             if beside:
                 why = str(exc) if isinstance(exc, WallcliError) else f"{side.name}: {exc}"
                 damaged.append((beside[0].name, "damaged sidecar: " + " ".join(why.split())))
+    _inside(d, named)
     _no_duplicates(d, named)
     return [c for _, c in named], damaged
 
