@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Session 12's transfer experiment (NOT the shipped models: models/train.sh makes those): the
 # 'wide' simulator domain, 'lite' nets reading both plots, trained and calibrated, then measured on
-# the independent transfer set. They did not beat the shipped models there (models/README.md), so
+# the independent transfer set. They did not beat the shipped models there (research/models-notebook.md), so
 # they write to runs/, not models/.
 #   bash research/transfer/train_wide.sh
 # Steps resume: rerunning skips finished shards and continues training from checkpoints.
