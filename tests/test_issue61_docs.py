@@ -88,3 +88,68 @@ def test_models_doc_has_no_empty_heading_and_no_loose_parenthesis():
         # a section that opens with an aside in brackets is an aside to a table that is not there
         assert not paragraphs[0].startswith("("), head
     assert "count 10 and 26" not in (ROOT / "docs" / "models.md").read_text()
+
+
+# 11 ---------------------------------------------------------------------- models/README.md
+_BANDS = {"empty rooms": "empty", "under 0 dB (not detectable)": "<0 dB", "0–10 dB": "0-10 dB",
+          "10 dB and over": ">=10 dB"}
+
+
+def test_models_page_is_what_ships_and_how_it_does_by_band():
+    import json
+
+    page = (ROOT / "models" / "README.md").read_text()
+    cards = {t: json.loads((ROOT / "models" / f"{t}.json").read_text()) for t in ("count", "activity")}
+    for task, card in cards.items():
+        assert f"{task} {card['version']}" in page  # the shipped versions, read from the cards
+    assert "0.4.1 and activity 0.3.1" not in page.split("Against the models shipped before")[0]
+    rows = {}
+    for line in page.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and cells[0] in _BANDS:
+            rows[_BANDS[cells[0]]] = cells[1:]
+    assert set(rows) == set(_BANDS.values())
+    for col, task in enumerate(("count", "activity")):
+        by_band = cards[task]["recordings"]["out_of_fold"]["by_band"]
+        for band, cells in rows.items():
+            assert cells[col] == f"{by_band[band]['right']} of {by_band[band]['clips']}", (task, band)
+        det = cards[task]["recordings"]["out_of_fold"]["detectable"]
+        assert f"{det['right']} of {det['clips']}" in page
+    assert f"{cards['count']['recordings']['clips']} labelled clips" in page
+    for section in ("## What they learnt from", "## How they do, by signal band", "## Limits"):
+        assert section in page
+    # the lab notebook lives in research/, not on the page a user reads
+    for notebook_word in ("proxy set", "superposition 0.2", "anneal", "120 clips"):
+        assert notebook_word not in page
+    assert len(page.splitlines()) < 150
+    notebook = ROOT / "research" / "models-notebook.md"
+    assert "research/models-notebook.md" in page and "anneal" in notebook.read_text()
+
+
+# 12 ----------------------------------------------------------------- the report's limits
+def test_report_says_what_the_shipped_models_learnt_from_as_its_limits_and_adapt_do():
+    from wallcli.infer.model import load_model
+    from wallcli.report.cards import model_summary
+
+    adapt = " ".join((ROOT / "docs" / "adapt.md").read_text().split())
+    assert "simulated rooms and from labelled rendered clips of other rooms" in adapt
+    for task in ("count", "activity"):
+        limits = " ".join(model_summary(load_model(task))["limits"])
+        assert "simulated rooms only" not in limits
+        assert "simulated rooms and from labelled rendered clips of other rooms" in limits
+        assert "never from camera footage" in limits
+    template = (ROOT / "wallcli" / "report" / "templates" / "clip.html.j2").read_text()
+    assert "simulated rooms and from labelled rendered clips of other rooms" in template
+
+
+def test_report_does_not_say_a_users_own_model_never_saw_camera_footage(tmp_path):
+    import shutil
+
+    from wallcli.infer.model import load_model, shipped_model_path
+    from wallcli.report.cards import model_summary
+
+    src = shipped_model_path("count")
+    shutil.copy(src, tmp_path / "mine.onnx")
+    shutil.copy(src.with_suffix(".json"), tmp_path / "mine.json")
+    limits = " ".join(model_summary(load_model("count", tmp_path / "mine.onnx"))["limits"])
+    assert "never from camera footage" not in limits and "its card's training_data" in limits

@@ -5,7 +5,16 @@ read with ``.get`` and a missing figure is reported as missing, never invented.
 """
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
+
+# What the shipped models learnt from, as the report's Limits and docs/adapt.md say it (models/README.md);
+# a model of the user's own learnt from what its card names, which may be camera footage
+LEARNT = ("It learnt from simulated rooms and from labelled rendered clips of other rooms (an independent "
+          "renderer's), never from camera footage; a room unlike them (other lights, other walls, a real "
+          "camera) can mislead it.")
+LEARNT_OWN = ("It learnt from what its card's training_data and recordings name; a room unlike those can "
+              "mislead it.")
 
 # Said of every shipped model of the task; a card's own "limitations" are listed after these.
 LIMITS = {
@@ -14,14 +23,12 @@ LIMITS = {
         "One against two people is its weakest distinction: two people are often counted as one.",
         "A faint or distant mover (beyond about 3.5 m from the wall, or under heavy video compression) reads as nobody.",
         "A person standing still may be counted when their sway shows on the wall.",
-        "It learnt from simulated rooms only; a room unlike them (other lights, other walls) can mislead it.",
     ],
     "activity": [
         "It names one activity of one person: none, walking, crouching, waving or jumping; anything else is "
         "forced into one of these.",
         "With two or more people its answer is not defined (it learnt from scenes of at most one person).",
         "A faint or distant mover reads as 'none'.",
-        "It learnt from simulated rooms only; a room unlike them (other lights, other walls) can mislead it.",
     ],
 }
 
@@ -114,6 +121,15 @@ def _transfer(block: Any) -> list[dict[str, Any]] | None:
     return out
 
 
+def _shipped(model) -> bool:
+    from wallcli.infer.model import shipped_model_path
+
+    try:
+        return Path(model.path).resolve() == shipped_model_path(model.task).resolve()
+    except (KeyError, OSError):  # a task without a shipped model, or a path that cannot be resolved
+        return False
+
+
 def model_summary(model) -> dict[str, Any]:
     card = model.card
     v = card.get("validation") if isinstance(card.get("validation"), dict) else {}
@@ -139,5 +155,5 @@ def model_summary(model) -> dict[str, Any]:
         "simulated": [s for s in sets if s["accuracy"] is not None or s["visible_accuracy"] is not None],
         "by_snr": by_snr,
         "transfer": _transfer(card.get("transfer")),
-        "limits": LIMITS.get(model.task, []) + own,
+        "limits": LIMITS.get(model.task, []) + [LEARNT if _shipped(model) else LEARNT_OWN] + own,
     }
