@@ -153,3 +153,20 @@ def test_report_does_not_say_a_users_own_model_never_saw_camera_footage(tmp_path
     shutil.copy(src.with_suffix(".json"), tmp_path / "mine.json")
     limits = " ".join(model_summary(load_model("count", tmp_path / "mine.onnx"))["limits"])
     assert "never from camera footage" not in limits and "its card's training_data" in limits
+
+
+# 14 ------------------------------------------------------------- docs/adapt.md's --init
+def test_every_documented_init_names_a_file_of_the_checkout():
+    """`--init "$(python -c ...)"` ran whichever python came first on PATH (not the venv's);
+    the README's `--init models/count.onnx` works from the checkout's top folder."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "models" / "README.md"]
+    found = 0
+    for page in pages:
+        text = page.read_text()
+        assert "$(python" not in text, page.name
+        for arg in re.findall(r"--init ([^\s`\\]+)", text):
+            if arg in ("M0.onnx",):  # the README's synopsis names a placeholder
+                continue
+            assert (ROOT / arg).is_file(), (page.name, arg)
+            found += 1
+    assert found >= 3
