@@ -71,8 +71,8 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     from wallcli.cli.output import emit_json, progress
     from wallcli.io.writer import check_outputs, committed_together
 
+    from wallcli.api import classify, load_model
     from wallcli.infer.model import shipped_model_path
-    from wallcli.infer.twostage import load_classifier
 
     # the models and their cards are inputs too: --plot over any must not replace it (a two-stage
     # count reads the activity model as well)
@@ -83,7 +83,7 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
     if task == "activity":  # its answers are checked by the count net for two people
         reads.append(shipped_model_path("count"))
     check_outputs([plot], force=force, inputs=reads)
-    model = load_classifier(task, model_path, threads=threads, activity_path=activity_model, single=single_stage)
+    model = load_model(task, model_path, threads=threads, activity_model=activity_model, single_stage=single_stage)
     stride = int(stride or model.card["stride"])
 
     if follow:
@@ -95,17 +95,13 @@ def run(task: str, input: str, *, stride: Optional[int], json_out: bool, plot: O
             emit_json(rec)
         return
 
-    from wallcli.infer.classify import classify_plot, classify_video, load_plot
-
+    # the Python API's own path (wallcli.api.classify); a video shows progress, a .npz is read at once
     if str(input).lower().endswith(".npz"):
-        st = load_plot(input, roi=roi_t, bins=model.bins)
-        result = classify_plot(model, st, stride=stride, source=str(input), corrections=fixes)
+        result, st = classify(model, input, stride=stride, roi=roi_t, corrections=fixes)
     else:
-        # a video is decoded once and classified window by window: memory does not grow with its
-        # length (--plot keeps a copy of bounded size for drawing, see classify_video)
         with progress(task, None) as advance:
-            result, st = classify_video(model, input, stride=stride, roi=roi_t,
-                                        progress=advance, keep_plot=plot is not None, corrections=fixes)
+            result, st = classify(model, input, stride=stride, roi=roi_t, progress=advance,
+                                  keep_plot=plot is not None, corrections=fixes)
     if strict:
         refuse_view(input, result.get("view"))
     with committed_together():  # the figure and the data on stdout: all or none

@@ -5,7 +5,6 @@ from __future__ import annotations
 import errno
 import io
 import json
-import math
 import os
 import re
 import sys
@@ -24,16 +23,11 @@ _SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _clean(obj: Any) -> Any:
-    """Make numpy scalars/arrays and non-finite floats JSON-safe (NaN/inf -> null, never invalid JSON)."""
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if hasattr(obj, "tolist") and not isinstance(obj, (str, bytes)):
-        return _clean(obj.tolist())
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    return obj
+    """Make numpy scalars/arrays and non-finite floats JSON-safe (NaN/inf -> null, never invalid JSON):
+    the conversion the Python API (wallcli.api) applies too."""
+    from wallcli.io.jsonfile import plain
+
+    return plain(obj)
 
 
 def to_json(obj: Any) -> str:

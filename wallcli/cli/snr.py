@@ -35,7 +35,7 @@ PREDICT_PARAMS = {
     "frames": ("--frames", 1.0, "Camera model: frames averaged.", dict(lo=1, hi=1e9)),
 }
 MAX_SWEEP = 10000
-AUTO_MIN_PX = 64  # --roi auto's smallest side: the space-time plots' 64 bins, one pixel each
+from wallcli.api import AUTO_MIN_PX  # noqa: E402  (the one figure, for the help text)
 
 
 def _predict_option(name: str):
@@ -130,90 +130,24 @@ def snr(
 # ------------------------------------------------------------------------------------- measure
 def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, force, threads, strict=False,
              corrections=None) -> None:
-    import warnings
-
-    from wallcli.camera.pipeline import CameraPipeline
+    from wallcli.api import measure_snr
     from wallcli.cli.common import parse_roi
     from wallcli.cli.output import emit_json, print_lines, print_table, progress, warn, wrote
-    from wallcli.errors import WallcliError
-    from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs
-    from wallcli.signal.blocks import check_roi
-    from wallcli.snr.estimate import SnrAccumulator, snr_db, snr_report
-    from wallcli.snr.map import GridAccumulator
-    from wallcli.view.check import ViewCheck
     from wallcli.wording import format_db
 
     auto = roi is not None and roi.strip().lower() == "auto"
-    roi_t = None if auto else parse_roi(roi)
+    roi_t = "auto" if auto else parse_roi(roi)
     check_outputs([heatmap, plot], force=force, inputs=[input])
-    if auto and (input == "-" or not Path(input).exists()):
-        raise WallcliError("--roi auto reads the video twice, so it needs a file (not '-' or a stream)"
-                           if input == "-" or "://" in input else f"no such file: {input}")
-    notes: list[str] = []
-    grid = auto_snr = avoid = None
-    if auto:
-        with open_video(input, threads=threads) as reader:
-            full = check_roi(None, reader.info.width, reader.info.height)
-            grid = GridAccumulator(full, 16, covariance=True)
-            whole = ViewCheck()  # where the view fails (a mover, clipping) is no place for the ROI
-            with progress("snr: finding the ROI", reader.info.frame_count) as advance:
-                for frame in CameraPipeline(reader, whole).frames():
-                    grid.update(frame.planes)
-                    whole(frame)
-                    advance()
-        avoid = whole.avoid(grid.grid_roi, grid.rows, grid.cols)
-        # a sliver makes fractional, overlapping bins of the same few pixels (a 10 px strip of
-        # walking.mp4 turned count's 1 into 2): at least one pixel per bin, or the whole frame's side
-        smallest = (-(-AUTO_MIN_PX // grid.ch), -(-AUTO_MIN_PX // grid.cw))
-        try:
-            roi_t, auto_snr = grid.best_roi(avoid, min_cells=smallest)
-        except ValueError:
-            notes.append("--roi auto: the view failed somewhere in every part of the frame (a mover "
-                         "or clipping); the ROI was chosen as if it had not")
-            roi_t, auto_snr = grid.best_roi(min_cells=smallest)
-            avoid[:] = False
-        if avoid.any():
-            notes.append(f"--roi auto left out {int(avoid.sum())} of {avoid.size} cells where the view check saw "
-                         "a moving object, clipping or black")
-    with open_video(input, threads=threads) as reader, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        roi_c = check_roi(roi_t, reader.info.width, reader.info.height)
-        acc = SnrAccumulator(roi_c, max_pixels=max_pixels, corrections=corrections, fps=float(reader.info.fps))
-        if heatmap is not None and grid is None:
-            grid = GridAccumulator(roi_c, 48)
-        feed_grid = grid if (grid is not None and not auto) else None
-        check = ViewCheck(roi_c)
-        # a repeated frame (a DVR's padding) is a missing sample: its zero difference is no noise;
-        # interlaced fields are brought to one instant, overlays masked
-        unique = CameraPipeline(reader, check)
-        with progress("snr", reader.info.frame_count) as advance:
-            for frame in unique.frames():
-                acc.update(frame.planes)
-                check(frame)
-                if feed_grid is not None:
-                    feed_grid.update(frame.planes)
-                advance()
-        fps = reader.fps  # the frames' own rate where it contradicts the container's
-    notes += [str(w.message) for w in caught]
-    result = snr_report(acc, source=input, fps=fps, notes=notes,
-                        roi_mode="auto" if auto else ("given" if roi_t is not None else "frame"))
-    result["corrections"] += unique.corrections()
-    if unique.repeats.correction():  # "frames" stays the file's; the entry says how many the estimator left out
-        result["frames"] = unique.decoded
-    result["view"] = check.summary()
+    # the Python API's own path (wallcli.api.measure_snr)
+    m = measure_snr(input, roi=roi_t, max_pixels=max_pixels, threads=threads, corrections=corrections,
+                    heatmap=heatmap is not None, progress=progress)
+    result, res, grid, avoid = m.result, m.res, m.grid, m.avoid
     if strict:
         from wallcli.cli.common import refuse_view
 
         refuse_view(input, result["view"])
-    res = acc.result()
     notes = result["warnings"]
-    if auto:
-        result["auto"] = {"criterion": "max SNR of the rectangle's spatially averaged grey level",
-                          "grid": [grid.rows, grid.cols], "snr_db": float(snr_db(auto_snr, 1.0)),
-                          "avoided_cells": int(avoid.sum()),
-                          "avoided": [k for k in ("moving object", "clipped", "too dark", "too little usable area")
-                                      if k in whole.view()["issues"]] if avoid.any() else []}
     if heatmap is not None:
         from wallcli.plots.snr import save_heatmap_png
 

@@ -59,51 +59,25 @@ def stplot(
     check_png_names(("--png", png))
     roi_t = parse_roi(roi)
 
+    from wallcli.api import compute_plot, narrow_roi
     from wallcli.cli.output import progress
-    from wallcli.io.video import open_video
     from wallcli.io.writer import check_outputs, committed_together
-    from wallcli.signal.stplot import compute_stplot
-
-    from wallcli.camera.pipeline import CameraPipeline
-    from wallcli.io.ahead import Ahead
-    from wallcli.io.video import FrameTee
-    from wallcli.view.check import ViewCheck
 
     check_outputs([output, png], force=force, inputs=[input])
-    # the view check and the camera's shifts ride on the same decode: the .npz keeps both, so that
-    # count and activity read from it answer as they would from the video (view verdict, shake)
-    check = ViewCheck(roi_t)
-    with open_video(input, threads=threads) as reader:
-        with progress("stplot", reader.info.frame_count) as advance:
-            # repeats left out, interlaced fields at one instant, overlays masked, as count reads it
-            # (its checks in a thread of their own, beside the projection: wallcli.io.ahead)
-            with Ahead(FrameTee(CameraPipeline(reader, check), (check,))) as frames:
-                plot = compute_stplot(frames, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds,
-                                      progress=advance, register=True, view=check)
+    # the Python API's own path (wallcli.api.compute_plot): one decode, the view check beside it
+    plot = compute_plot(input, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds, threads=threads,
+                        progress=progress)
     narrow = narrow_roi(plot.meta["roi"], plot.bins)
     if narrow:
         from wallcli.cli.output import warn
 
-        plot.meta.setdefault("warnings", []).append(narrow)
-        warn(narrow)
+        warn(narrow)  # compute_plot put it in the .npz's warnings
     with committed_together():  # the .npz, the PNG and the JSON: all or none
         _write(plot, input, output, png, style, gain, json_out, force)
     from wallcli.cli.output import wrote
 
     shape = f"{plot.bins} positions x {plot.frames} frames"
     wrote((output, f"horizontal and vertical space-time plots, {shape}"), (png, "both plots, amplified"))
-
-
-def narrow_roi(roi, bins: int) -> str | None:
-    """A warning when the ROI has fewer pixels on a side than the plots have bins: the bins then
-    interpolate between the same few pixels, and the plot holds no more independent positions
-    than pixels (a 10 px strip gives 64 bins of 10 pixels' worth)."""
-    _, _, w, h = roi
-    if min(w, h) >= bins:
-        return None
-    side = f"{w} px wide" if w <= h else f"{h} px high"
-    return (f"the ROI ({w}x{h} px) is {side}, fewer pixels than its {bins} bins: neighbouring bins share "
-            f"pixels, so the plots hold at most {min(w, h)} independent positions (use a larger ROI or --bins)")
 
 
 def check_summary(meta: dict) -> dict | None:

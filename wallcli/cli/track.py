@@ -88,17 +88,15 @@ def track(
     files = [p for p in (csv, png) if p is not None and str(p) != "-"]
     check_outputs(files, force=force, inputs=[input])
     from wallcli.cli.output import progress, wrote
-    from wallcli.infer.track import track_plot, track_video
+    from wallcli.api import track_clip
 
+    # the Python API's own path (wallcli.api.track_clip); a video shows progress, a .npz is read at once
     if str(input).lower().endswith(".npz"):
-        from wallcli.infer.classify import load_plot
-
-        plot = load_plot(input, roi=roi_t)
-        result, st = track_plot(plot, str(input), view_width=view_width)
+        result, st = track_clip(input, roi=roi_t, view_width=view_width)
     else:
         with progress("track", None) as advance:
-            result, st = track_video(input, roi=roi_t, threads=threads, progress=advance, keep_plot=png is not None,
-                                     view_width=view_width, corrections=corrections_of(False, False, False))
+            result, st = track_clip(input, roi=roi_t, threads=threads, progress=advance, keep_plot=png is not None,
+                                    view_width=view_width)
     if strict:
         refuse_view(input, result.get("view"))
     with committed_together():

@@ -56,3 +56,20 @@ def _depth_exceeds(obj: Any, limit: int) -> bool:
             return True
         stack.extend((c, d + 1) for c in children if isinstance(c, (dict, list)))
     return False
+
+
+def plain(obj: Any) -> Any:
+    """``obj`` made JSON-safe as wallcli writes it: numpy scalars and arrays as Python numbers and
+    lists, tuples as lists, keys as str, NaN and infinities as None (never invalid JSON). The one
+    conversion behind every ``--json`` and the Python API (wallcli.api), so that both give one object."""
+    import math
+
+    if isinstance(obj, dict):
+        return {str(k): plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [plain(v) for v in obj]
+    if hasattr(obj, "tolist") and not isinstance(obj, (str, bytes)):
+        return plain(obj.tolist())
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    return obj
