@@ -22,7 +22,7 @@ def count(source, *, model=None, stride: int | None = None, roi: Roi = None, thr
           shake: bool = True) -> dict[str, Any]:
     """How many people (0, 1, 2) move out of view: the object of ``wallcli count SOURCE --json``.
 
-    ``source``: a video (path, URL) or a ``.npz`` from :func:`save_stplot` / ``wallcli stplot``.
+    ``source``: a video (path, URL) or a ``.npz`` written by ``wallcli stplot``.
     ``model``: an .onnx with its card beside it (default: the shipped one); ``threads``: onnxruntime's.
     """
     net = load_model("count", model, threads=threads, activity_model=activity_model, single_stage=single_stage)
