@@ -170,3 +170,41 @@ def test_every_documented_init_names_a_file_of_the_checkout():
             assert (ROOT / arg).is_file(), (page.name, arg)
             found += 1
     assert found >= 3
+
+
+# 13 ------------------------------------------------------------------------------- README
+README = (ROOT / "README.md").read_text()
+
+
+def _readme_pipeline_lines() -> list[str]:
+    block = README.split("\nPipelines", 1)[1]
+    return [ln for ln in re.search(r"```bash\n(.*?)```", block, re.S).group(1).splitlines() if ln.strip()]
+
+
+def test_pipeline_lines_write_under_out_not_the_checkouts_top():
+    written = []
+    for line in _readme_pipeline_lines():
+        code = line.split("  #")[0]
+        written += re.findall(r"(?:-o|--png|--plot|--heatmap|--csv)\s+(\S+)", code)
+        for m in re.finditer(r"wallcli \w+ (\S+\.npz)", code):
+            written.append(m.group(1))
+    assert written and all(w.startswith("out/") for w in written), written
+
+
+def test_quick_start_names_every_command_pipeline_sh_runs():
+    script = (ROOT / "examples" / "pipeline.sh").read_text()
+    ran = set(re.findall(r"^\$w (\w+)", script, re.M))
+    assert "track" in ran
+    quick = README.split("## Quick start", 1)[1].split("\n## ", 1)[0]
+    assert {c for c in ran if f"`{c}`" not in quick} == set()
+
+
+def test_the_follow_lines_comment_says_the_last_line_is_the_whole_clip(run_cli):
+    import json
+
+    line = next(ln for ln in _readme_pipeline_lines() if "--follow" in ln)
+    assert "then one for the whole clip" in line
+    code, out, err = run_cli("activity", ROOT / "examples" / "walking.mp4", "--follow")
+    records = [json.loads(x) for x in out.splitlines()]
+    assert code == 0 and len(records) >= 2, err
+    assert "windows" in records[-1] and all("windows" not in r for r in records[:-1])
