@@ -45,11 +45,30 @@ def track_plot(plot, source: str, *, view_width: float | None = None):
 
         span = f"{t[-1] - t[0]:.2f} s" if len(t) else "no samples"
         raise WallcliError(f"{source} is too short: {len(t)} sample(s), {span}; tracking needs {MIN_SAMPLES / FPS:g} s")
-    fps = float((len(t) - 1) / (t[-1] - t[0]))
-    extra = {}
-    if isinstance((plot.meta or {}).get("view"), dict):
-        extra["view"] = plot.meta["view"]
-    return track_result(source, track_rows(rows, t, fps), fps=round(fps, 3), view_width=view_width, extra=extra), plot
+    steps = np.diff(t)
+    # the frames' own interval, not the span over the count: lost frames (a gap) are no slower rate
+    fps = float(1.0 / np.median(steps[steps > 0])) if np.any(steps > 0) else FPS
+    from wallcli.infer.windows import plot_fps
+
+    fps = plot_fps(plot, source) or fps  # count's rule and refusal (io.rates.plot_rate): the video's rate
+    extra, view = {}, None
+    if isinstance((plot.meta or {}).get("view"), dict):  # the verdict of the video's check, kept by stplot
+        from wallcli.view.check import ViewCheck
+
+        # the same view block as the video's (and count's on this file): its summary, not the raw record
+        view = ViewCheck.restore(plot.meta["view"]).summary()
+        extra["view"] = view
+    gaps = [tuple(g) for g in (view or {}).get("gaps", [])]
+    result = track_result(source, track_rows(rows, t, fps, gaps=gaps), fps=fps, view_width=view_width,
+                          extra=extra)
+    return _judged(result, view), plot
+
+
+def _judged(result: dict[str, Any], view: dict | None) -> dict[str, Any]:
+    """Where the view is no static wall, the tracks may be the camera's, not people's: the reason says so."""
+    if view is not None and not view.get("usable", True):
+        result["reason"] = f"view not usable: {view.get('reason')}"
+    return result
 
 
 def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_plot: bool = False,
@@ -59,9 +78,9 @@ def track_video(source: str, *, roi=None, threads: int = 0, progress=None, keep_
     from wallcli.infer.stream import PlotThumbnail
     from wallcli.io.video import open_video
 
-    builder = TrackBuilder(FPS)
     thumb = PlotThumbnail() if keep_plot else None
     with open_video(source, threads=threads) as reader:
+        builder = TrackBuilder(FPS, gaps=lambda: reader.gaps)  # rows across lost frames are interpolated
         with _Decode(_ROWS, reader, roi=roi, corrections=corrections, progress=progress, ahead=True) as decode:
             rows = decode.rows
             for t, row in rows:
@@ -81,10 +100,9 @@ def _video_result(source: str, builder: TrackBuilder, decode, view_width: float 
                            f"{MIN_SAMPLES / FPS:g} s")
     view = decode.check.summary()
     extra = {"view": view, "corrections": decode.unique.corrections(), "duration": round(builder.samples / FPS, 3)}
-    result = track_result(source, builder.finish(), fps=FPS, view_width=view_width, extra=extra)
-    if not view.get("usable", True):
-        result["reason"] = f"view not usable: {view.get('reason')}"
-    return result
+    # fps: the video's rate (as snr and count report it); the rows are at FPS
+    return _judged(track_result(source, builder.finish(), fps=float(decode.reader.fps), view_width=view_width,
+                                extra=extra), view)
 
 
 def track_csv(result: dict) -> str:
@@ -104,7 +122,7 @@ def follow_tracks(source: str, *, roi=None, threads: int = 0, view_width: float 
     from wallcli.infer.classify import _Decode
     from wallcli.io.video import open_video
 
-    builder = TrackBuilder(FPS)
+    builder = None
     said: dict[int, int] = {}  # samples already printed, per track
 
     def news():
@@ -115,6 +133,7 @@ def follow_tracks(source: str, *, roi=None, threads: int = 0, view_width: float 
                 yield {"id": k.id, "samples": k.as_dict(view_width)["samples"][n:]}
 
     with open_video(source, threads=threads) as reader:
+        builder = TrackBuilder(FPS, gaps=lambda: reader.gaps)
         decode = _Decode(_ROWS, reader, roi=roi, corrections=corrections)
         for t, row in decode.rows:
             builder.push(t, row[:BINS])

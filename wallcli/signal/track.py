@@ -36,6 +36,7 @@ BRIDGE_SECONDS = 1.5  # a path's runs this close are one track (a shade fades as
 MIN_SECONDS = 1.0  # shorter runs over the threshold are not tracks
 OUT_HZ = 10.0  # samples per second in a track
 LINK_WIDTH = 0.12  # of the width: two tracks meeting at a chunk boundary are one when this close
+GAP_STEPS, GAP_MIN = 5.0, 0.25  # rows this many steps and seconds apart have frames lost between them (as io's reader)
 # How far the streak's place is from the person's (view widths): the 68th percentile of the error on
 # the rendered recordings' single walkers, 0.34-0.55 fold by fold, covering 66 % out of fold
 # (research/track/README.md). A shade falls where the light puts it, so this is large; it is the
@@ -202,8 +203,13 @@ class TrackBuilder:
     """Tracks from a stream of horizontal rows ``push(t, row (bins[, colours]))``, in memory that
     does not grow with the stream's length (one chunk of rows, and the tracks' 10 Hz samples)."""
 
-    def __init__(self, fps: float):
+    def __init__(self, fps: float, gaps=None):
         self.fps = float(fps)
+        # frames lost: (time of the frame before, time of the frame after). A list, or a callable
+        # giving the list so far (a decoder's, which knows of a gap before its rows arrive). Rows
+        # inside one are interpolated, not seen: no sample is kept there and no track crosses one.
+        self._given = gaps if callable(gaps) else (lambda g=list(gaps or []): g)
+        self._jumps: list[tuple[float, float]] = []  # jumps of the pushed rows' own times
         self.chunk = max(8, int(round(CHUNK_SECONDS * self.fps)))
         self.overlap = int(round(OVERLAP_SECONDS * self.fps))
         self._rows: list[np.ndarray] = []
@@ -214,6 +220,8 @@ class TrackBuilder:
         self.samples = 0
 
     def push(self, t: float, row: np.ndarray) -> None:
+        if self._t and t - self._t[-1] > max(GAP_STEPS / self.fps, GAP_MIN):
+            self._jumps.append((self._t[-1], float(t)))
         self._rows.append(np.asarray(row, np.float32))
         self._t.append(float(t))
         self.samples += 1
@@ -238,11 +246,20 @@ class TrackBuilder:
         end_time = times[-1]
         still_open = []
         every = max(1, int(round(self.fps / OUT_HZ)))
-        for seg in sorted(segs, key=lambda s: s["t"][0]):
+        gaps = self.gaps()
+        pieces = []
+        for seg in segs:
             sel = np.arange(0, len(seg["t"]), every)
-            t, x, sg, st = (seg[k][sel] for k in ("t", "x", "sigma", "strength"))
+            cut = _split_at_gaps({k: seg[k][sel] for k in ("t", "x", "sigma", "strength")}, gaps)
+            for c in cut:  # where each piece's rows end (a sample is every few rows)
+                c["end"] = float(c["t"][-1])
+            if cut and _piece(float(seg["t"][-1]), gaps) == _piece(cut[-1]["end"], gaps):
+                cut[-1]["end"] = float(seg["t"][-1])
+            pieces += cut
+        for seg in sorted(pieces, key=lambda s: s["t"][0]):
+            t, x, sg, st = (seg[k] for k in ("t", "x", "sigma", "strength"))
             new = t > start_new
-            track = self._link(t, x) if new.any() and t[0] <= start_new + 1.0 / OUT_HZ + 1e-9 else None
+            track = self._link(t, x, gaps) if new.any() and t[0] <= start_new + 1.0 / OUT_HZ + 1e-9 else None
             if not new.any():
                 continue
             if track is None:
@@ -253,17 +270,22 @@ class TrackBuilder:
                     continue
                 track.t.append(float(a)), track.x.append(float(b)), track.sigma.append(float(c))
                 track.strength.append(float(d))
-            if not final and seg["t"][-1] >= end_time - 1.5 / self.fps:
+            if not final and seg["end"] >= end_time - 1.5 / self.fps:
                 still_open.append(track)
         self._open = still_open
         self._done_until = end_time
 
-    def _link(self, t: np.ndarray, x: np.ndarray) -> Track | None:
-        """The open track this chunk's segment continues, if any: the closest in place where it ended."""
+    def gaps(self) -> list[tuple[float, float]]:
+        """The frames lost so far, given and found in the rows' times, in time order."""
+        return sorted({(float(a), float(b)) for a, b in [*self._given(), *self._jumps]})
+
+    def _link(self, t: np.ndarray, x: np.ndarray, gaps) -> Track | None:
+        """The open track this chunk's segment continues, if any: the closest in place where it ended
+        (none across frames lost)."""
         best, gap = None, LINK_WIDTH
         for tr in self._open:
             j = int(np.searchsorted(t, tr.t[-1]))
-            if j >= len(t):
+            if j >= len(t) or _piece(tr.t[-1], gaps) != _piece(float(t[0]), gaps):
                 continue
             d = abs(x[j] - tr.x[-1])
             if d <= gap:
@@ -273,9 +295,32 @@ class TrackBuilder:
         return best
 
 
-def track_rows(rows: np.ndarray, times: np.ndarray, fps: float) -> list[Track]:
-    """The tracks of a whole (T, bins[, colours]) plot held in memory (a .npz from stplot)."""
-    b = TrackBuilder(fps)
+def _piece(t: float, gaps) -> int:
+    """How many gaps lie before time ``t`` (samples of one track share this)."""
+    return sum(1 for a, _ in gaps if a < t - 1e-6)
+
+
+def _split_at_gaps(seg: dict, gaps) -> list[dict]:
+    """``seg`` without its samples inside a gap (no frame was there), cut where a gap lies between
+    two of them: a track ends at frames lost, however close the shade is on either side."""
+    t = seg["t"]
+    if not gaps or not len(t):
+        return [seg] if len(t) else []
+    inside = np.zeros(len(t), bool)
+    for a, b in gaps:
+        inside |= (t > a + 1e-6) & (t < b - 1e-6)
+    piece = np.array([_piece(float(v), gaps) for v in t])
+    out = []
+    for p in np.unique(piece[~inside]):
+        keep = (piece == p) & ~inside
+        out.append({k: v[keep] for k, v in seg.items()})
+    return out
+
+
+def track_rows(rows: np.ndarray, times: np.ndarray, fps: float, gaps=None) -> list[Track]:
+    """The tracks of a whole (T, bins[, colours]) plot held in memory (a .npz from stplot);
+    ``gaps``: frames lost, (time before, time after), besides the jumps of ``times``."""
+    b = TrackBuilder(fps, gaps)
     for t, r in zip(times, rows):
         b.push(float(t), r)
     return b.finish()
