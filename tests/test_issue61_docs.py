@@ -208,3 +208,11 @@ def test_the_follow_lines_comment_says_the_last_line_is_the_whole_clip(run_cli):
     records = [json.loads(x) for x in out.splitlines()]
     assert code == 0 and len(records) >= 2, err
     assert "windows" in records[-1] and all("windows" not in r for r in records[:-1])
+
+
+def test_the_report_pictures_caption_is_the_command_its_script_runs():
+    caption = re.search(r"\*`(wallcli report [^`]+)`, top of the page", README).group(1)
+    script = (ROOT / "examples" / "report_screenshot.sh").read_text()
+    ran = re.search(r"^\$W (report .+)$", script, re.M).group(1)
+    assert caption == f"wallcli {ran}"
+    assert "out/" in caption  # outside examples/, as every output of the examples
