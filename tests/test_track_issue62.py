@@ -112,3 +112,40 @@ def test_no_sample_where_no_frame_is_and_no_track_across_a_gap(tmp_path, run_cli
         ts = np.array([s["t"] for s in k["samples"]])
         assert not ((ts > a + 1e-3) & (ts < b - 1e-3)).any(), (k["start"], k["end"])
         assert not ((ts <= a + 1e-3).any() and (ts >= b - 1e-3).any())
+
+
+# ------------------------------------------------------------------- 6: a followed file replaced
+def _opened(pid: int, path) -> bool:
+    import os
+
+    try:
+        return any(os.path.realpath(f"/proc/{pid}/fd/{fd}") == str(path) for fd in os.listdir(f"/proc/{pid}/fd"))
+    except OSError:
+        return False
+
+
+@pytest.mark.parametrize("how", ["random", "shrink"])
+def test_follow_says_a_file_truncated_or_overwritten_and_exits_1(tmp_path, how):
+    import subprocess
+    import sys
+    import time
+
+    clip = _gappy(tmp_path / "rec.mkv", 0.0)
+    size = clip.stat().st_size
+    proc = subprocess.Popen([sys.executable, "-m", "wallcli", "track", str(clip), "--follow", "--idle-timeout", "8"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not _opened(proc.pid, clip.resolve()) and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+        time.sleep(1.0)
+        with open(clip, "r+b") as fh:  # in place, as a recorder restarting on the same name would
+            fh.truncate(0)
+            fh.write(np.random.default_rng(0).bytes(size if how == "random" else 2000))
+        out, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    lines = err.strip().splitlines()
+    assert proc.returncode == 1, err
+    assert lines[-1].startswith("Error:") and ("shrank" in lines[-1] or "replaced" in lines[-1]), err
+    assert "Traceback" not in err

@@ -11,6 +11,7 @@ from wallcli.errors import WallcliError
 
 _POLL = 0.2  # s: how often a wait on a stream looks at its stop flag (a signal ends it within this)
 FLUSH_FACTOR = 3.0  # a followed file ends after this many of its longest waits for growth, if longer
+HEAD = 4096  # bytes: a followed file's beginning, compared while waiting for it to grow
 
 
 class _Stopped(Exception):
@@ -78,6 +79,8 @@ class StreamInput:
         except OSError as exc:
             return self._put(exc)
         try:
+            if self.idle is not None:  # a growing file: what it began with, to tell it was overwritten
+                self._path, self._head = path, os.pread(fd, HEAD, 0)
             while not self._stop.is_set():
                 chunk = os.read(fd, 1 << 16)
                 if not chunk and self.idle is not None and self._grows(fd):
@@ -87,8 +90,26 @@ class StreamInput:
                     break
         except OSError as exc:
             self._put(exc)
+        except WallcliError as exc:
+            self._put(exc)
         finally:
             os.close(fd)
+
+    def _same_file(self, fd: int, end: int) -> None:
+        """A followed file only grows: one that shrank under the read, or whose first bytes or inode
+        changed, was truncated or replaced, and what was read of it no longer describes it (a
+        recorder restarted on the same name, a file overwritten): WallcliError, not a quiet end."""
+        size = os.fstat(fd).st_size
+        if size < end:
+            raise WallcliError(f"{self.source} shrank while it was followed ({end} bytes read, {size} now): "
+                               "it was truncated or replaced; the result so far is of the file before")
+        try:
+            moved = os.stat(self._path).st_ino != os.fstat(fd).st_ino
+        except OSError:
+            moved = True
+        if moved or os.pread(fd, len(self._head), 0) != self._head:
+            raise WallcliError(f"{self.source} was replaced while it was followed (its first bytes or the file "
+                               "itself changed); the result so far is of the file before")
 
     def _grows(self, fd: int) -> bool:
         """At the end of a file being written: whether it grows within ``idle`` seconds, or within
@@ -98,6 +119,7 @@ class StreamInput:
 
         end, waited = os.lseek(fd, 0, os.SEEK_CUR), 0.0
         while not self._stop.is_set() and waited < max(self.idle, FLUSH_FACTOR * self._longest):
+            self._same_file(fd, end)
             if os.fstat(fd).st_size > end:
                 # the wait is a lower bound of the recorder's pause (not the time we spent reading)
                 self._longest = max(self._longest, waited)
@@ -143,6 +165,8 @@ class StreamInput:
                     if self.stall is not None and waited >= self.stall:
                         raise WallcliError(f"{self.source}: no data for {self.stall:g} s (its writer stalled)",
                                            hint="--stall-timeout SECONDS waits longer; 0, for ever")
+            if isinstance(item, WallcliError):
+                raise item
             if isinstance(item, OSError):
                 raise WallcliError(f"cannot read {self.source}: {item.strerror or item}")
             if not item:
