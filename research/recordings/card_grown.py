@@ -74,7 +74,9 @@ def main() -> None:
         card["recordings"] = rec
         card["transfer"] = new["transfer"]
         card["transfer"]["description"] = rendered(card["transfer"]["description"])
-        path.write_text(json.dumps(card, indent=2) + "\n")
+        from wallcli.infer.card import card_text  # sealed: these figures are the measured ones
+
+        path.write_text(card_text(card))
         print(task, rec["out_of_fold"]["detectable"]["right"], "of", rec["out_of_fold"]["detectable"]["clips"])
 
 

@@ -119,7 +119,8 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
 
         save_timeline_png(plot, result, st, force=force)
     # the model card's figures are for a reader who asks (-v), on stderr: not on every call
-    note = accuracy_note(model.card, single_stage=task == "count" and model.single) if verbose else None
+    note = accuracy_note(model.card, single_stage=task == "count" and model.single,
+                         unvalidated=getattr(model, "unvalidated", None)) if verbose else None
     if json_out:
         emit_json(result)
         if note:
@@ -154,12 +155,13 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
         log(note)
 
 
-def accuracy_note(card: dict, single_stage: bool = False) -> str | None:
+def accuracy_note(card: dict, single_stage: bool = False, unvalidated: str | None = None) -> str | None:
     """One line saying how far the model's answers can be trusted, from its card's validation.
 
     Printed with -v (to stderr, for the reader, not for scripts; not on every call, where it was
     six lines under every table): a probability of 0.9 from a model that is right on 64 % of
-    windows is not a 90 % answer.
+    windows is not a 90 % answer. An unvalidated card (``unvalidated``: why, infer/trust.py) has
+    no figure worth quoting: the line says so instead.
     """
     tr = card.get("transfer") or {}
     if single_stage and tr.get("stages"):  # the card's headline is the two-stage count's, not this net's alone
@@ -169,6 +171,9 @@ def accuracy_note(card: dict, single_stage: bool = False) -> str | None:
         iv = tr.get("ci95")
         ci = f" (95 % CI {iv[0]:.0%}-{iv[1]:.0%})" if isinstance(iv, list) and len(iv) == 2 else ""
         dec = ""
+    if unvalidated:
+        return (f"{card.get('name', 'model')} {card.get('version', '')}: {unvalidated}; none of its "
+                "validation figures are quoted and no answer is decided.")
         if isinstance(tr.get("coverage"), (int, float)) and isinstance(tr.get("accuracy_decided"), (int, float)):
             dec = f"; it decided {tr['coverage']:.0%} of them and was right on {tr['accuracy_decided']:.0%} of those"
         st = tr.get("stages") if isinstance(tr.get("stages"), dict) else None

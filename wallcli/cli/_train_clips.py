@@ -1,7 +1,6 @@
 """``wallcli train --clips DIR [--folds K]``: the recordings' windows, the out-of-fold table, the card's block."""
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -77,7 +76,7 @@ def judge_out_of_fold(recs, answers, task, classes, level, k) -> tuple[dict, dic
 
 def write_block(out: Path, block: dict[str, Any]) -> dict[str, Any]:
     """The card of ``out`` with ``recordings`` and, from its folds, the ``confidence`` thresholds."""
-    from wallcli.infer.card import card_path, read_card
+    from wallcli.infer.card import card_path, card_text, read_card
     from wallcli.io.writer import write_text_atomic
 
     card = read_card(out)
@@ -101,14 +100,14 @@ def write_block(out: Path, block: dict[str, Any]) -> dict[str, Any]:
             card.pop("confidence", None)
         else:
             card["confidence"] = trust
-    write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=True)
+    write_text_atomic(card_path(out), card_text(card), force=True)
     return read_card(out)
 
 
 def keep_init(init: Path, out: Path, block: dict[str, Any], *, name, version, force: bool) -> dict[str, Any]:
     """``--epochs 0``: OUT is --init's graph, byte for byte, with a card that says so and carries
     what was fitted on the recordings."""
-    from wallcli.infer.card import card_path, read_card
+    from wallcli.infer.card import card_path, card_text, read_card
     from wallcli.io.writer import atomic_path, write_text_atomic
 
     card = read_card(init)
@@ -121,7 +120,7 @@ def keep_init(init: Path, out: Path, block: dict[str, Any], *, name, version, fo
     fitted = [k for k in ("split",) if k in block] + (["confidence"] if block.get("folds") else [])
     card.setdefault("training", {})["recordings_stage"] = {
         "init": base, "note": "the net is --init's, unchanged; fitted on the recordings: " + ", ".join(fitted)}
-    write_text_atomic(card_path(out), json.dumps(card, indent=2) + "\n", force=force)
+    write_text_atomic(card_path(out), card_text(card), force=force)
     return write_block(out, block)
 
 

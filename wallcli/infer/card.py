@@ -209,7 +209,16 @@ def _validate_accuracy(block: Any, name: str, bad) -> None:
             _validate_accuracy(other, f"{name}.other_sets[{i}]", bad)
 
 
+def card_text(card: dict[str, Any]) -> str:
+    """``card`` as the JSON text wallcli writes: sealed (its ``trust`` block set to the digest of
+    the fields it was just given, :mod:`wallcli.infer.trust`), since whoever writes a card through
+    here has just measured them."""
+    from wallcli.infer.trust import seal
+
+    return json.dumps(seal(card), indent=2) + "\n"
+
+
 def write_card(path: Path, card: dict[str, Any]) -> None:
-    """Write ``card`` as JSON to ``path`` (the caller handles atomicity)."""
+    """Write ``card``, sealed, as JSON to ``path`` (the caller handles atomicity)."""
     validate_card(card, path)
-    Path(path).write_text(json.dumps(card, indent=2) + "\n", encoding="utf-8")
+    Path(path).write_text(card_text(card), encoding="utf-8")

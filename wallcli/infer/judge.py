@@ -16,6 +16,8 @@ def judge_answer(model, raw, probs: np.ndarray, signal_db: float) -> tuple[bool,
 
 
 def _judge(model, probs: np.ndarray, signal_db: float) -> tuple[bool, str | None]:
+    if getattr(model, "unvalidated", None):  # its thresholds are not the ones measured: none are quoted
+        return False, model.unvalidated
     block = model.card.get("confidence")
     confident, reason = confidence.judge(block, probs, signal_db, model.classes)
     if not block and model.no_block_reason():

@@ -39,6 +39,10 @@ class Model:
         self._data = data
         self.threads = threads
         self._session = None
+        from wallcli.infer.trust import problem
+
+        # why the card's thresholds and figures may not be relied upon (None: sealed as measured)
+        self.unvalidated = problem(card)
 
     @classmethod
     def load(cls, path: Path | str, *, task: str | None = None, threads: int = 0) -> "Model":

@@ -78,6 +78,8 @@ class TwoStageCount:
         self.card["confidence"] = block.get("confidence") if self.calibrated else None
         self.card["two_stage"] = block
         self.path = count.path
+        # a pair is as validated as its less validated card (the prior odds and thresholds are the count card's)
+        self.unvalidated = getattr(count, "unvalidated", None) or getattr(activity, "unvalidated", None)
         # the prior odds of two people against one (the card's, fixed from the share of two-person
         # rooms in the footage it was validated for; 1 = the count net's own even prior)
         odds = block.get("prior_two_vs_one", 1.0)
@@ -205,6 +207,9 @@ class OnePersonActivity:
         except WallcliError:  # your own activity model, on windows the count net cannot read
             self.pair = None
         self.count = count if self.pair is not None else None
+        # the count net's check reads its card's prior odds: an edited one unvalidates the answers too
+        self.unvalidated = (getattr(activity, "unvalidated", None)
+                            or (self.pair.unvalidated if self.pair is not None else None))
 
     classes = property(lambda self: self.activity.classes)
     window = property(lambda self: self.activity.window)

@@ -8,13 +8,12 @@ card is rewritten atomically.
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from wallcli.infer.card import card_path, read_card
+from wallcli.infer.card import card_path, card_text, read_card
 from wallcli.infer.confidence import fit
 from wallcli.signal.window import window_signal_db
 
@@ -80,7 +79,7 @@ def calibrate(model_path: Path, data: list[Path], *, level: float, edges: list[f
     }
     card = read_card(model_path)
     card["confidence"] = block
-    write_text_atomic(card_path(model_path), json.dumps(card, indent=2) + "\n", force=True)
+    write_text_atomic(card_path(model_path), card_text(card), force=True)
     return block
 
 
