@@ -216,3 +216,36 @@ def test_the_report_pictures_caption_is_the_command_its_script_runs():
     ran = re.search(r"^\$W (report .+)$", script, re.M).group(1)
     assert caption == f"wallcli {ran}"
     assert "out/" in caption  # outside examples/, as every output of the examples
+
+
+# 16 (second half) ----------------------------------------------------------------- research/
+_OTHERS = ("render", "snr")  # folders of work in progress elsewhere, not this page's to judge
+
+
+def _research_pages() -> list[Path]:
+    pages = [ROOT / "research" / "README.md", *sorted((ROOT / "research").glob("*/README*.md")),
+             ROOT / "research" / "models-notebook.md"]
+    return [p for p in pages if p.parent.name not in _OTHERS]
+
+
+def test_research_pages_say_when_not_which_ticket_or_work_period():
+    inside = re.compile(r"\b(issues?|sessions?)[ -]#?\d+|(?<![\w/])#\d+\b|\bsessions?\b", re.I)
+    found = {str(p.relative_to(ROOT)): inside.findall(p.read_text()) for p in _research_pages()}
+    assert {k: v for k, v in found.items() if v} == {}
+    assert len(found) >= 15
+
+
+def test_research_keeps_no_stale_patches_and_no_raw_verdict_logs():
+    files = [p for p in (ROOT / "research").rglob("*") if p.is_file()
+             and not any(part in _OTHERS for part in p.relative_to(ROOT / "research").parts[:1])]
+    assert not [p for p in files if p.suffix == ".patch"]  # kept in git history, named by commit
+    big_text = [p for p in files if p.suffix in (".jsonl", ".log") and p.stat().st_size > 100_000]
+    assert big_text == []
+    # the view check's verdicts, which back docs/real-footage.md's figures, are kept compressed
+    import gzip
+    import json
+
+    for name in ("moving_object", "cuts", "sharp_light"):
+        lines = gzip.open(ROOT / "research" / "view" / f"verdicts_{name}.jsonl.gz", "rt").read().splitlines()
+        assert len(lines) > 500 and all("file" in json.loads(x) for x in lines)
+        assert f"verdicts_{name}.jsonl.gz" in (ROOT / "research" / "view" / "README.md").read_text()

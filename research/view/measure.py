@@ -1,4 +1,4 @@
-"""False alarms and catches of the view check (issue #27) on generated clips.
+"""False alarms and catches of the view check (measured from 2026-11-25) on generated clips.
 
 Wall clips: the simulator in each domain (base, shifted, wide, steady; lighting nuisances and
 sub-pixel shake as each domain draws them), H.264 as `wallcli simulate` writes. Not-a-wall clips:

@@ -1,5 +1,5 @@
-"""Session 22 (issue 36 part 1): would a first-order registration catch the shakes and pans the
-view check misses? Tried, not kept (research/view/README.md, session 22).
+"""2026-11-26: would a first-order registration catch the shakes and pans the
+view check misses? Tried, not kept (research/view/README.md, "First-order registration").
 
 The check verifies a shift the phase correlation found by asking whether the reference's texture
 fits better moved by it than in place: a second-order test, whose gain for a shift s on a band of
@@ -196,7 +196,7 @@ def _score(rows, verdict, need) -> collections.Counter:
 
 
 def by_wall(rows, se_max=0.2, good_min=4) -> collections.Counter:
-    """The definition tried in registrable_note.patch: a wall is registrable when none of its
+    """The definition tried in registrable_note.patch (commit e10f80d): a wall is registrable when none of its
     still clip's checks has fewer than ``good_min`` tiles pinning a shift to ``se_max`` px; the
     view check's own catches of pans and shakes >= 1 px, on the walls it calls registrable and on
     the others (a sample made with walls: sweep.py make --kinds wall,pan,shake)."""
