@@ -94,7 +94,8 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     out: dict[str, Any] = {"frames": unique.decoded, "duration": round(unique.last_time + 1.0 / fps, 6), "fps": fps,
                            "warnings": notes, "view": check.summary()}
     for task, c in zip(classify, classifiers):
-        out[task] = bound_result(with_view(c.result(source, frames=unique.decoded), check), blend.correction())
+        out[task] = bound_result(with_view(c.result(source, frames=unique.decoded, fps=fps), check),
+                                 blend.correction())
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
     for task in TASKS:

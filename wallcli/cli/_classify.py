@@ -137,7 +137,7 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
         return [first, shown(r), format_db(r.get("signal_db")), *(f"{p:.3f}" for p in r["probabilities"])]
 
     rows = [row(f"{w['start']:.2f}", w) for w in result["windows"]] + [row("clip", result)]
-    span = result["window"] / result["fps"]
+    span = result["window"] / result.get("window_fps", result["fps"])  # fps: the video's rate
     n = len(result["windows"])
     print_table(f"{input}: {task} = {answer_text(result)}; {n} window{'' if n == 1 else 's'} of {span:.2f} s",
                 ["start (s)", "answer", "signal dB", *map(label_text, result["classes"])], rows)

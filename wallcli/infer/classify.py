@@ -20,13 +20,13 @@ from wallcli.camera import corrections as corr
 from wallcli.errors import WallcliError
 from wallcli.infer.judge import judge_view, with_view
 from wallcli.infer.result import clip_result, window_record
-from wallcli.infer.windows import WindowStream, plot_windows, stream_row
+from wallcli.infer.windows import WindowStream, plot_fps, plot_windows, stream_row
 
 
 def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
     windows = plot_windows(model, plot, stride=stride, source=source, corrections=corrections)
-    result = clip_result(model, *windows, stride=stride, source=source)
+    result = clip_result(model, *windows, stride=stride, source=source, fps=plot_fps(plot, source))
     view = (plot.meta or {}).get("view")
     if isinstance(view, dict):  # the verdict of the video's check, kept by stplot
         from wallcli.view.check import ViewCheck
@@ -42,10 +42,12 @@ class WindowClassifier(WindowStream):
     scan`` feeds one decode to a classifier per task (and to the SNR estimator).
     """
 
-    def result(self, source: str, frames: int | None = None) -> dict[str, Any]:
+    def result(self, source: str, frames: int | None = None, fps: float | None = None) -> dict[str, Any]:
         """The docs/contract.md result; WallcliError when the stream was shorter than one window
-        (quoting ``frames``, the video's decoded frames, where given)."""
-        return clip_result(self.model, *self.windows(str(source), frames), stride=self.stride, source=str(source))
+        (quoting ``frames``, the video's decoded frames, where given). ``fps``: the video's rate as
+        read (VideoReader.fps); default the container's (``native_fps``)."""
+        return clip_result(self.model, *self.windows(str(source), frames), stride=self.stride, source=str(source),
+                           fps=fps or self.native_fps)
 
 
 def _too_short_video(source: str, check, model, frames: int | None = None) -> WallcliError:
@@ -111,7 +113,7 @@ class _Decode:
         camera blended its noise, signal_db is an upper bound."""
         from wallcli.camera.tnr import bound_result
 
-        result = with_view(classifier.result(source, frames=self.unique.decoded), self.check)
+        result = with_view(classifier.result(source, frames=self.unique.decoded, fps=self.reader.fps), self.check)
         result["corrections"] += self.unique.corrections()
         return bound_result(result, self.blend.correction())
 

@@ -39,9 +39,12 @@ def window_record(model, start: float, raw: np.ndarray, signal_db: float) -> dic
     return rec
 
 
-def clip_result(model, times, probs, signal_db, found=None, *, stride: int, source: str) -> dict[str, Any]:
+def clip_result(model, times, probs, signal_db, found=None, *, stride: int, source: str,
+                fps: float | None = None) -> dict[str, Any]:
     """The docs/contract.md result from window start times, their probabilities (n, classes),
-    measured signals (n,) in dB and what each window's corrections found (``found``)."""
+    measured signals (n,) in dB and what each window's corrections found (``found``). ``fps``: the
+    video's frame rate (what ``"fps"`` reports, as snr does); the windows' samples are at the model's
+    rate, ``"window_fps"``."""
     found = found if found is not None else [[] for _ in times]
     raw = probs.mean(axis=0)  # each net's mean over the windows (a two-stage count combines these)
     clip = model.combine(raw)[0]
@@ -52,7 +55,8 @@ def clip_result(model, times, probs, signal_db, found=None, *, stride: int, sour
         "input": source,
         "task": model.task,
         "model": model.info(),
-        "fps": float(model.fps),
+        "fps": float(fps) if fps else float(model.fps),
+        "window_fps": float(model.fps),
         "classes": model.classes,
         "label": model.classes[int(np.argmax(clip))],
         "probabilities": [float(p) for p in clip],

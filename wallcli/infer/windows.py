@@ -26,13 +26,13 @@ def too_short(source: str, frames: int, model, fps: float | None = None) -> Wall
         f"one window needs {model.window} frames at {model.fps:g} fps ({model.window / model.fps:.2f} s)")
 
 
-def native_fps(time) -> float | None:
-    """The frame rate of a plot's own timestamps (before resampling), None when unknown."""
-    time = np.asarray(time, np.float64)
-    if time.size < 3:
-        return None
-    d = float(np.median(np.diff(time)))
-    return 1.0 / d if d > 0 else None
+def plot_fps(plot, source: str) -> float | None:
+    """The frame rate of a space-time plot's video (:func:`wallcli.io.rates.plot_rate`: the one rule
+    of count, activity and track), refusing one outside the rates wallcli reads."""
+    from wallcli.io.rates import plot_rate
+
+    rate = plot_rate(plot.meta, plot.time, source)
+    return None if rate is None else float(rate)
 
 
 def resampled_plots(model, plot, both: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
@@ -64,10 +64,7 @@ def corrected(model, wins: dict, offsets: dict, native, options, starts=None, sh
 def plot_windows(model, plot, *, stride: int, source: str, corrections: corr.Options):
     """(starts (s), raw outputs (n, ...), signals (n,) dB, findings per window) of a whole
     space-time plot, ``CHUNK`` windows at a time."""
-    from wallcli.io.video import check_rate
-
-    if native_fps(plot.time) is not None:  # a plot of an older wallcli, made before videos were checked
-        check_rate(native_fps(plot.time), source)
+    rate = plot_fps(plot, source)  # refused as its video would be, whichever command reads it
     plots, grid = resampled_plots(model, plot, both=corrections.light)
     shifts = None
     if corrections.shake and getattr(plot, "shift", None) is not None and plot.frames >= 2:
@@ -79,9 +76,9 @@ def plot_windows(model, plot, *, stride: int, source: str, corrections: corr.Opt
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     starts = run_window_starts(grid, model.fps, model.window, stride)  # none spans a gap
     if not starts:
-        raise too_short(source, plot.frames, model, native_fps(plot.time))
+        raise too_short(source, plot.frames, model, rate)
     probs, signal, found = [], [], []
-    native = native_fps(plot.time)
+    native = rate
     for i in range(0, len(starts), CHUNK):
         chunk = starts[i:i + CHUNK]
         wins = {name: np.stack([p[:, s:s + model.window] for s in chunk]) for name, p in plots.items()}

@@ -23,9 +23,13 @@ RATE_PROBE = 16
 RATE_TOLERANCE = 0.02
 
 
+# how far a rate computed in floating point (1 / 0.004166...) may overshoot a bound and still be on it
+_ROUNDING = 1e-9
+
+
 def check_rate(fps: float, source: str) -> None:
     """Refuse a frame rate outside MIN_FPS-MAX_FPS: one line, the same for every command."""
-    if not (MIN_FPS <= float(fps) <= MAX_FPS):
+    if not (MIN_FPS * (1 - _ROUNDING) <= float(fps) <= MAX_FPS * (1 + _ROUNDING)):
         raise WallcliError(f"{source}: {float(fps):.3g} fps; wallcli reads videos of {MIN_FPS:g} to {MAX_FPS:g} fps "
                            "(the models' windows and the SNR estimator assume frames a fraction of a second apart)")
 
@@ -130,11 +134,51 @@ class FrameClock:
         whatever the container says (one frame an hour in a file labelled 30 fps); one tick of
         the time base either way is the timestamps' rounding (240 fps in milliseconds: 4 or 5)."""
         intervals, self.first_intervals = self.first_intervals, None
-        if not intervals or len(intervals) < 2:
-            return
-        m = float(np.median(intervals))
-        tick = float(self.tb or 0)
-        fastest = 1.0 / max(m - tick, 1e-12)
-        slowest = 1.0 / (m + tick) if m + tick > 0 else math.inf
-        if fastest < MIN_FPS or slowest > MAX_FPS:
-            check_rate(1.0 / m if m > 0 else math.inf, self.source)
+        check_intervals(intervals or [], float(self.tb or 0), self.source)
+
+
+def check_intervals(intervals, tick: float, source: str) -> None:
+    """Refuse frames whose median spacing is outside the rates wallcli reads, give or take one
+    ``tick`` of their time base (their timestamps' rounding): the rule for a video's first frames
+    and for a space-time plot's times alike."""
+    if len(intervals) < 2:
+        return
+    m = float(np.median(intervals))
+    fastest = 1.0 / max(m - tick, 1e-12)
+    slowest = 1.0 / (m + tick) if m + tick > 0 else math.inf
+    if fastest < MIN_FPS * (1 - _ROUNDING) or slowest > MAX_FPS * (1 + _ROUNDING):
+        check_rate(1.0 / m if m > 0 else math.inf, source)
+
+
+# The tick assumed for a plot that does not record its video's time base (one written before it
+# did): a millisecond, Matroska's, the coarsest that timestamps of a 240 fps video come in
+PLOT_TICK = Fraction(1, 1000)
+
+
+def fraction(text, default=None) -> Fraction | None:
+    """A positive rational written as "N/D" (or a number) in a plot's metadata; ``default`` where absent
+    or malformed."""
+    try:
+        f = Fraction(str(text)) if text is not None and not isinstance(text, bool) else None
+    except (ValueError, ZeroDivisionError):
+        return default
+    return f if f is not None and f > 0 else default
+
+
+def plot_rate(meta: dict, times, source: str) -> Fraction | None:
+    """The frame rate of a space-time plot, the one rule for every command that reads one: the video's
+    rate as stplot recorded it (``fps_fraction``, exact), else what its times say (frames over their
+    span, gaps and timestamp rounding averaged out); refused as the video would be (check_rate),
+    and so are times whose median spacing is outside the rates read, give or take one tick of the
+    video's time base (``time_base``; a millisecond where not recorded). None: too few times to say."""
+    times = np.asarray(times, np.float64)
+    rate = fraction((meta or {}).get("fps_fraction"))
+    if rate is None and times.size >= 2 and times[-1] > times[0]:
+        steps = np.diff(times)
+        typical = float(np.median(steps))
+        steady = steps[steps <= GAP_FACTOR * typical]  # frames lost are no slower rate
+        rate = Fraction((steady.size / float(steady.sum()))).limit_denominator(1001)
+    if rate is not None:
+        check_rate(rate, source)
+    check_intervals(np.diff(times), float(fraction((meta or {}).get("time_base"), PLOT_TICK)), source)
+    return rate

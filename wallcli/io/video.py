@@ -65,6 +65,9 @@ class VideoInfo:
     # where fps came from: 'container', 'codec' (its headers) or 'assumed'; a plot's meta also
     # 'timestamps' (the frames' own rate, where it contradicts the container's)
     fps_source: str = "container"
+    # the stream's time base: its timestamps are whole multiples of it, so a frame's time is exact
+    # to one tick of it (a millisecond in Matroska: a 240 fps clip's frames are 4 or 5 ms apart)
+    time_base: Fraction | None = None
 
 
 @dataclass
@@ -165,6 +168,7 @@ class VideoReader:
             codec=str(cc.name or ""),
             container=container_name,
             fps_source=fps_source,
+            time_base=Fraction(stream.time_base) if stream.time_base else None,
         )
         if self._input is not None and not self.following and self.info.codec in REENCODED:
             self._warn(f"{source}: the stream is {REENCODED[self.info.codec]} ({self.info.codec}), a lossy codec "

@@ -259,10 +259,10 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     from wallcli.infer.track import MIN_SAMPLES, track_result
 
     if tracker.samples >= MIN_SAMPLES:
-        out.tracks = track_result(str(source), tracker.finish(), fps=float(first.fps))
+        out.tracks = track_result(str(source), tracker.finish(), fps=float(fps))  # the video's rate
     for task, c in classifiers.items():
         try:
-            out.results[task] = bound_result(with_view(c.result(str(source), frames=rows.frames), tee.view),
+            out.results[task] = bound_result(with_view(c.result(str(source), frames=rows.frames, fps=fps), tee.view),
                                              tee.blend.correction())
             out.results[task]["corrections"] += tee.pipeline.corrections()
         except WallcliError as exc:  # too short for one window: the rest of the report still stands

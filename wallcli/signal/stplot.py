@@ -177,6 +177,8 @@ def compute_stplot(
         "fps": fps,
         "fps_fraction": f"{frac.numerator}/{frac.denominator}",
         "fps_source": getattr(info, "fps_source", "container") if fps == float(info.fps) else "timestamps",
+        # the tick the times are exact to, for the rate check of whoever reads the plot (io.rates.plot_rate)
+        "time_base": _ratio(getattr(info, "time_base", None)),
         "frames": times.n,
         "roi": list(roi),
         "bins": int(bins),
@@ -192,6 +194,10 @@ def compute_stplot(
         meta["view"] = view.record()
     return _finish(h_rows.array(), v_rows.array(), times.array(), meta, mean, mean_seconds,
                    None if shifts is None else shifts.array())
+
+
+def _ratio(value) -> str | None:
+    return None if not value else f"{Fraction(value).numerator}/{Fraction(value).denominator}"
 
 
 def to_arrays(plot: StPlot) -> tuple[dict[str, np.ndarray], dict]:
