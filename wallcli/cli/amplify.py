@@ -18,12 +18,14 @@ SIDE_BUFFER_BYTES = 64 * 1024 * 1024
 # (measured here: 420 MB at 2560x1920; --scale 100 of a 64x48 ROI, 6400x4800, reached 7.5 GB as
 # the encoder's threads each held frames), and a block grid blown up further shows nothing more.
 MAX_OUTPUT_PIXELS = 2 * 3840 * 2160
+MAX_SIDE = 16384  # pixels on either side of a panel (H.264 levels end there)
 
 
-def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
+def parse_scale(text: str, width: int, height: int, panels: int = 1) -> tuple[int, int]:
     """'0.5' (factor) or '640x360' (pixels) -> even (width, height) for H.264 4:2:0. A factor's
     size is rounded to even numbers (at least 2); a size given in pixels is written as given or
-    refused, never silently changed."""
+    refused, never silently changed. ``panels``: 2 with --side-by-side. The limits come first, so
+    that a refusal never suggests a size that is refused in turn (99999x99999 suggested 100000x100000)."""
     from wallcli.errors import UsageError
 
     t = text.strip().lower()
@@ -31,17 +33,28 @@ def parse_scale(text: str, width: int, height: int) -> tuple[int, int]:
         if "x" in t:
             w_s, h_s = t.split("x", 1)
             w, h = float(int(w_s)), float(int(h_s))
-            if w > 0 and h > 0 and (w % 2 or h % 2):
-                raise UsageError(f"--scale {text}: H.264 (4:2:0) needs an even width and height, of 2 or more "
-                                 f"(e.g. {max(2, 2 * round(w / 2))}x{max(2, 2 * round(h / 2))})")
         else:
             f = float(t)
             w, h = width * f, height * f
     except ValueError:
         raise UsageError(f"--scale must be a factor like 0.5 or a size like 640x360 (got {text!r})") from None
-    if not (w > 0 and h > 0) or w > 16384 or h > 16384:
-        raise UsageError(f"--scale gives an unusable output size {w:.0f}x{h:.0f}")
-    return max(2, 2 * round(w / 2)), max(2, 2 * round(h / 2))
+    if not (w > 0 and h > 0) or w > MAX_SIDE or h > MAX_SIDE:
+        raise UsageError(f"--scale gives an unusable output size {w:.0f}x{h:.0f} (each side from 2 to {MAX_SIDE} "
+                         "pixels)")
+    pw, ph = _even(w), _even(h)
+    if panels * pw * ph > MAX_OUTPUT_PIXELS:
+        raise UsageError(f"--scale {text} makes {panels * pw}x{ph} output frames ({panels * pw * ph / 1e6:.1f} "
+                         f"megapixels); amplify writes at most {MAX_OUTPUT_PIXELS / 1e6:.1f} (two 3840x2160 panels): "
+                         "use a smaller --scale")
+    if "x" in t and (w % 2 or h % 2):
+        raise UsageError(f"--scale {text}: H.264 (4:2:0) needs an even width and height, of 2 or more "
+                         f"(e.g. {pw}x{ph})")
+    return pw, ph
+
+
+def _even(x: float) -> int:
+    """The even size nearest ``x``, from 2 to MAX_SIDE (a suggestion is never one that is refused)."""
+    return min(MAX_SIDE, max(2, 2 * round(x / 2)))
 
 
 def amplify(
@@ -117,6 +130,17 @@ def amplify(
                 preset, json_out, force, threads)
 
 
+def _warn_small(rw: int, rh: int) -> None:
+    """The tiny-ROI warning snr, count and track give (their view check's 'too small to check'),
+    said for amplify's output: a 2x2 ROI became a 2x2 video, without a word."""
+    from wallcli.cli.output import warn
+    from wallcli.view.limits import MIN_REGISTER_SIDE as side
+
+    if rw < side or rh < side:
+        warn(f"the ROI ({rw}x{rh} px) is too small to check for camera motion (it needs {side}x{side} pixels or "
+             f"more), and the amplified video shows at most {rw}x{rh} independent blocks: use a larger ROI")
+
+
 def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
             preset, json_out, force, threads) -> None:
     import itertools
@@ -140,7 +164,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         size = (first.planes.width, first.planes.height) if first is not None else (info.width, info.height)
         roi_t = check_roi(roi_t, *size)
         _, _, rw, rh = roi_t
-        pw, ph = parse_scale(scale, rw, rh)
+        pw, ph = parse_scale(scale, rw, rh, 2 if side_by_side else 1)
         calib = max(2, round(gain_seconds * float(info.fps)))
         if side_by_side:
             calib = max(2, min(calib, SIDE_BUFFER_BYTES // (pw * ph * 3)))
@@ -179,9 +203,10 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                         write(amp.push(frame.time, grids, (frame.time, left)))
                         frames += 1
                         advance()
-                write(amp.flush() if amp is not None else [])
-                if frames < 2:
+                if frames < 2:  # before the flush, which cannot measure one frame (an internal error)
                     raise WallcliError(f"{input}: only {frames} frame(s); amplify needs at least 2")
+                write(amp.flush() if amp is not None else [])
+    _warn_small(rw, rh)  # once the video is written: a run that fails says one line, its error
     rows, cols = grid_shape(rw, rh, amp.cells)
     rate = reader.fps  # the frames' own rate where it contradicts the container's
     rate_f = info.fps if rate == float(info.fps) else Fraction(rate).limit_denominator(1001)

@@ -161,10 +161,13 @@ def load_plot(source: str | Path, *, roi=None, threads: int = 0, bins: int = 64,
         from wallcli.io.arrays import load_npz
         from wallcli.signal.stplot import FORMAT, from_arrays
 
-        if roi is not None:
-            from wallcli.errors import UsageError
+        from wallcli.errors import UsageError
+        from wallcli.io.video import STREAM
 
+        if roi is not None:
             raise UsageError("--roi applies to videos; a space-time plot already has its region")
+        if STREAM.get() is not None:  # (count's and track's --stream) was ignored without a word
+            raise UsageError("--stream applies to videos; a space-time plot already holds one stream's plots")
         return from_arrays(*load_npz(source, kind=FORMAT), source=str(source))
     from wallcli.io.video import open_video
     from wallcli.signal.stplot import compute_stplot

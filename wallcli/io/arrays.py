@@ -49,6 +49,15 @@ def _write_npy(fid, a: np.ndarray, step_bytes: int = 1 << 16) -> None:
         fid.write(np.ascontiguousarray(a[i:i + step]).data)
 
 
+def _compressed(p: Path) -> bool:
+    """Whether any member of the zip at ``p`` is stored compressed (np.savez_compressed)."""
+    try:
+        with zipfile.ZipFile(p) as zf:
+            return any(i.compress_type != zipfile.ZIP_STORED for i in zf.infolist())
+    except (OSError, zipfile.BadZipFile):
+        return False
+
+
 def _declared_bytes(p: Path) -> int | None:
     """The bytes the .npy members' headers declare, read before any array is; None if unreadable
     (np.load then says what is wrong)."""
@@ -81,9 +90,13 @@ def load_npz(path: str | os.PathLike, *, kind: str | None = None) -> tuple[dict[
         raise WallcliError(f"{p} is not a readable .npz file (not a zip archive)")
     declared = _declared_bytes(p)
     if declared is not None and declared > max(UNPACK_FREE, 2 * p.stat().st_size):
-        raise WallcliError(f"{p} unpacks to {declared / 1e9:.2f} GB of arrays from {p.stat().st_size / 1e6:.1f} MB "
-                           f"(compressed); wallcli reads a .npz of at most twice its size or "
-                           f"{UNPACK_FREE >> 20} MB", hint="write it uncompressed (np.savez), as wallcli does")
+        size = f"{declared / 1e9:.2f} GB of arrays from {p.stat().st_size / 1e6:.1f} MB"
+        if _compressed(p):
+            raise WallcliError(f"{p} unpacks to {size} (compressed); wallcli reads a .npz of at most twice its "
+                               f"size or {UNPACK_FREE >> 20} MB", hint="write it uncompressed (np.savez), as wallcli does")
+        # stored uncompressed, the headers claim arrays the file does not hold: damaged or crafted
+        raise WallcliError(f"{p} is not a readable .npz file: its headers declare {size} (uncompressed), "
+                           "more than the file holds")
     try:
         with np.load(p, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
