@@ -43,7 +43,7 @@ def test_one_walker_is_one_track_that_follows_the_shade():
     assert tracks[0].duration > 10
     assert np.corrcoef(x, truth)[0, 1] > 0.98
     assert np.median(np.abs(x - truth)) < 0.03
-    assert all(s >= tr.GEOMETRY_SIGMA for s in tracks[0].sigma)
+    assert all(s >= min(g for _, g in tr.GEOMETRY_BY_STRENGTH) for s in tracks[0].sigma)
     assert tr.simultaneous(tracks)["seconds"] == 0.0
 
 

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from wallcli.camera import corrections as corr
-from wallcli.signal.track import GEOMETRY_SIGMA, TrackBuilder, simultaneous, track_rows
+from wallcli.signal.track import GEOMETRY_BY_STRENGTH, GEOMETRY_SIGMA, TrackBuilder, simultaneous, track_rows
 
 BINS, FPS = 64, 30.0
 # what _Decode needs of a model: the rows' shape and rate (the tracker reads no net)
@@ -26,7 +26,9 @@ def track_result(source: str, tracks, *, fps: float, view_width: float | None = 
     """The ``wallcli track --json`` object of ``tracks`` (docs/contract.md)."""
     out = {"input": source, "task": "track", "fps": fps,
            "method": {"name": "wallcli-streaks", "unit": "fraction of the view's width at its mid-height",
-                      "geometry_sigma": GEOMETRY_SIGMA},
+                      "geometry_sigma": GEOMETRY_SIGMA,
+                      # each sample's sigma: its sigma_shade with this, by the shade's strength (log-interpolated)
+                      "geometry_sigma_by_strength": [list(p) for p in GEOMETRY_BY_STRENGTH]},
            "tracks": [t.as_dict(view_width) for t in tracks],
            "simultaneous": simultaneous(tracks)}
     if view_width is not None:

@@ -15,7 +15,8 @@ Positions are the streak's, as a fraction of the plot's width (0 = the first bin
 left; 1 = the last bin's edge); a shade outside the view is not seen, so x stays within 0-1. A shade falls where the light's direction puts it, so the streak
 can be offset from, or move faster than, the person, and a side window mirrors it
 (research/track/README.md measures it on the rendered recordings' motion-capture truth): ``sigma``
-is the streak's own width combined with that geometric spread, measured out of fold.
+is the streak's own half width (``shade``: where the shade is) combined with that geometric spread
+at the shade's strength (GEOMETRY_BY_STRENGTH: where the person is, 68 % of the time out of fold).
 """
 from __future__ import annotations
 
@@ -39,9 +40,21 @@ LINK_WIDTH = 0.12  # of the width: two tracks meeting at a chunk boundary are on
 GAP_STEPS, GAP_MIN = 5.0, 0.25  # rows this many steps and seconds apart have frames lost between them (as io's reader)
 # How far the streak's place is from the person's (view widths): the 68th percentile of the error on
 # the rendered recordings' single walkers, 0.34-0.55 fold by fold, covering 66 % out of fold
-# (research/track/README.md). A shade falls where the light puts it, so this is large; it is the
-# floor of every sample's sigma.
+# (research/track/README.md). A shade falls where the light puts it, so this is large. It is the
+# pooled figure; each sample's own uses GEOMETRY_BY_STRENGTH.
 GEOMETRY_SIGMA = 0.45
+# The same percentile by the shade's strength (darkness in noise units; centres of the recordings'
+# thirds of samples): a strong shade is a person near a bright light (a lamp, a window), whose shade
+# falls far from them and magnified, a faint one a person lit broadly, whose shade is under them.
+# Between the centres it is interpolated on log strength, beyond them held. Out of fold (each
+# fold's table from the other four) it covers 66 % of the samples (research/track/sigma.py).
+GEOMETRY_BY_STRENGTH = ((6.5, 0.337), (19.3, 0.396), (77.8, 0.571))
+
+
+def geometry_sigma(strength) -> np.ndarray:
+    """The shade-to-person part of sigma at each sample's ``strength`` (view widths)."""
+    s, g = (np.array(v, np.float64) for v in zip(*GEOMETRY_BY_STRENGTH))
+    return np.interp(np.log10(np.maximum(np.asarray(strength, np.float64), 1.0)), np.log10(s), g)
 
 
 @dataclass
@@ -51,6 +64,7 @@ class Track:
     x: list[float] = field(default_factory=list)
     sigma: list[float] = field(default_factory=list)
     strength: list[float] = field(default_factory=list)
+    shade: list[float] = field(default_factory=list)  # the streak's own half width: where the shade is
 
     @property
     def duration(self) -> float:
@@ -58,8 +72,9 @@ class Track:
 
     def as_dict(self, view_width: float | None = None) -> dict:
         samples = []
-        for t, x, s in zip(self.t, self.x, self.sigma):
-            d = {"t": round(float(t), 3), "x": round(float(x), 4), "sigma": round(float(s), 4)}
+        for t, x, s, w in zip(self.t, self.x, self.sigma, self.shade):
+            d = {"t": round(float(t), 3), "x": round(float(x), 4), "sigma": round(float(s), 4),
+                 "sigma_shade": round(float(w), 4)}
             if view_width is not None:
                 d["x_m"] = round(float((x - 0.5) * view_width), 4)
             samples.append(d)
@@ -191,8 +206,8 @@ def chunk_segments(rows: np.ndarray, times: np.ndarray, fps: float) -> list[dict
                 i = np.arange(b - a)
                 x = np.interp(i, i[seen], x[seen])
                 w = np.where(seen, w, np.maximum(w, np.abs(x - (p + 0.5) / B)))  # as far as the path strayed
-            out.append({"t": times[a:b], "x": x, "sigma": np.sqrt(w ** 2 + GEOMETRY_SIGMA ** 2),
-                        "strength": held[a:b]})
+            out.append({"t": times[a:b], "x": x, "sigma": np.sqrt(w ** 2 + geometry_sigma(held[a:b]) ** 2),
+                        "shade": w, "strength": held[a:b]})
         for t in range(T):  # the next path keeps off this one's whole dip (a broad shade is one person)
             g = max(guard, int(np.ceil(2.0 * _width(dark[t], int(path[t])))))
             score[t, max(0, path[t] - g):path[t] + g + 1] = -1e6
@@ -250,14 +265,14 @@ class TrackBuilder:
         pieces = []
         for seg in segs:
             sel = np.arange(0, len(seg["t"]), every)
-            cut = _split_at_gaps({k: seg[k][sel] for k in ("t", "x", "sigma", "strength")}, gaps)
+            cut = _split_at_gaps({k: seg[k][sel] for k in ("t", "x", "sigma", "strength", "shade")}, gaps)
             for c in cut:  # where each piece's rows end (a sample is every few rows)
                 c["end"] = float(c["t"][-1])
             if cut and _piece(float(seg["t"][-1]), gaps) == _piece(cut[-1]["end"], gaps):
                 cut[-1]["end"] = float(seg["t"][-1])
             pieces += cut
         for seg in sorted(pieces, key=lambda s: s["t"][0]):
-            t, x, sg, st = (seg[k] for k in ("t", "x", "sigma", "strength"))
+            t, x, sg, st, sh = (seg[k] for k in ("t", "x", "sigma", "strength", "shade"))
             new = t > start_new
             track = self._link(t, x, gaps) if new.any() and t[0] <= start_new + 1.0 / OUT_HZ + 1e-9 else None
             if not new.any():
@@ -265,11 +280,11 @@ class TrackBuilder:
             if track is None:
                 track = Track(id=len(self.tracks))
                 self.tracks.append(track)
-            for a, b, c, d in zip(t[new], x[new], sg[new], st[new]):
+            for a, b, c, d, e in zip(t[new], x[new], sg[new], st[new], sh[new]):
                 if track.t and a <= track.t[-1]:
                     continue
                 track.t.append(float(a)), track.x.append(float(b)), track.sigma.append(float(c))
-                track.strength.append(float(d))
+                track.strength.append(float(d)), track.shade.append(float(e))
             if not final and seg["end"] >= end_time - 1.5 / self.fps:
                 still_open.append(track)
         self._open = still_open
