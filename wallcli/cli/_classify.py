@@ -136,11 +136,17 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
     def row(first, r):
         return [first, shown(r), format_db(r.get("signal_db")), *(f"{p:.3f}" for p in r["probabilities"])]
 
+    # the headline figure is the title's first figure (the title stays the first line, for grep);
+    # the table's figure is the models' own, headed by its JSON name
+    from wallcli.snr.column import column_text
+
+    headline = f"; {column_text(result['column_snr_db'])}" if "column_snr_db" in result else ""
+
     rows = [row(f"{w['start']:.2f}", w) for w in result["windows"]] + [row("clip", result)]
     span = result["window"] / result.get("window_fps", result["fps"])  # fps: the video's rate
     n = len(result["windows"])
-    print_table(f"{input}: {task} = {answer_text(result)}; {n} window{'' if n == 1 else 's'} of {span:.2f} s",
-                ["start (s)", "answer", "signal dB", *map(label_text, result["classes"])], rows)
+    print_table(f"{input}: {task} = {answer_text(result)}; {n} window{'' if n == 1 else 's'} of {span:.2f} s{headline}",
+                ["start (s)", "answer", "signal_db", *map(label_text, result["classes"])], rows)
     # one line under the table: why the clip's answer is decided or not
     if result.get("confident") is True:
         level = (model.card.get("confidence") or {}).get("level")

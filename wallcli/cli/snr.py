@@ -165,7 +165,10 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
         warn(n)
     if not result["view"]["usable"]:  # the figures below then measure more than a wall's light
         warn(result["view"]["reason"])
-    print_lines([f"Verdict: {result['verdict']['text']}."])
+    from wallcli.snr.column import column_text
+
+    # the headline figure first, by its name; the verdict's and the table's are block SNRs
+    print_lines([f"{column_text(result.get('column_snr_db'))}.", f"Verdict: {result['verdict']['text']}."])
     how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
     print_table(
         f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "

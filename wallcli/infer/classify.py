@@ -27,6 +27,9 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
     """The docs/contract.md result for a whole space-time plot (a .npz file, already in memory)."""
     windows = plot_windows(model, plot, stride=stride, source=source, corrections=corrections)
     result = clip_result(model, *windows, stride=stride, source=source, fps=plot_fps(plot, source))
+    from wallcli.snr.column import plot_column_snr_db
+
+    result["column_snr_db"] = plot_column_snr_db(plot)  # the headline figure (wallcli.snr.column)
     view = (plot.meta or {}).get("view")
     if isinstance(view, dict):  # the verdict of the video's check, kept by stplot
         from wallcli.view.check import ViewCheck
@@ -132,8 +135,12 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     from wallcli.infer.stream import PlotThumbnail
     from wallcli.io.video import open_video
 
+    from wallcli.snr.column import ColumnSnr
+
     classifier = WindowClassifier(model, stride, corrections=corrections)
     thumb = PlotThumbnail() if keep_plot else None
+    column = ColumnSnr(roi)  # the headline figure, from the same decode
+    taps = (*taps, column)
     with open_video(source, threads=threads) as reader:
         classifier.native_fps = float(reader.info.fps)
         for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
@@ -148,6 +155,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
                 classifier.push(t, stream_row(row, rows), rows.ref)
         decode.refuse_short(classifier, str(source))
     result = decode.result(classifier, str(source))
+    result["column_snr_db"] = column.db()
     return result, (thumb.plot(rows, model.bins, model.fps) if thumb is not None else None)
 
 
