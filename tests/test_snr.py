@@ -292,7 +292,8 @@ def test_a_verdict_comes_first_and_tells_an_empty_room_from_a_walker(run_cli):
     for name in ("empty", "walking"):
         code, out, err = run_cli("snr", examples / f"{name}.mp4")
         assert code == 0, err
-        first = out.splitlines()[0]
+        headline, first = out.splitlines()[:2]  # the headline figure (issue 61), then the verdict
+        assert headline.startswith("column SNR ") and len(headline) <= 80
         assert first.startswith("Verdict: ") and len(first) <= 80
         code, out, _ = run_cli("snr", examples / f"{name}.mp4", "--json")
         seen[name] = json.loads(out)["verdict"]

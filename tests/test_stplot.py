@@ -70,16 +70,16 @@ def _capture_titles(monkeypatch) -> list:
     return titles
 
 
-def test_the_figure_title_writes_full_scale_as_plus_minus(tmp_path, run_cli, monkeypatch):
-    """'full scale = +-0.513' read as code; the title says '\u00b10.51' (two digits)."""
+def test_the_colour_scale_writes_full_scale_as_plus_minus():
+    """'full scale = +-0.513' read as code; the figure says '\u00b10.51' (two digits), on its colour
+    scale since issue 61."""
     import re
 
-    titles = _capture_titles(monkeypatch)
-    clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
-    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "p.png")
-    assert code == 0, err
-    assert "+-" not in titles[0] and re.search(r"full scale \u00b1\d(\.\d+)? code values", titles[0]), titles[0]
-    assert not re.search(r"\u00b1\d\.\d{3}", titles[0])
+    from wallcli.plots.stplot import scale_label
+
+    label = scale_label(0.975)
+    assert "+-" not in label and re.search(r"full scale \u00b1\d(\.\d+)? ", label), label
+    assert not re.search(r"\u00b1\d\.\d{3}", label)
 
 
 def test_stplot_png_and_styles(tmp_path, run_cli):
@@ -127,20 +127,17 @@ def test_decoded_frame_size_wins_over_the_announced_one():
     assert np.allclose(plot.h_mean[:, 0], [101, 101, 111, 111])
 
 
-def test_the_figure_title_names_the_gain_in_words(tmp_path, run_cli, monkeypatch):
-    """Issue 46 item 11: the title said a bare 'x0.975'. That number is the colour gain (display
-    range per code value of signal); the title now names it and says how it was set."""
-    import re
+def test_the_figure_names_the_gain_in_words_on_its_colour_scale(tmp_path, run_cli, monkeypatch):
+    """Issue 46 item 11: the title said a bare 'x0.975'. Issue 61: the gain's words widened the
+    figure through its title; they are on the colour scale now (full scale in code values, and how
+    it was set), and the title is short."""
+    from wallcli.plots import stplot
 
     titles = _capture_titles(monkeypatch)
     clip = write_clip(tmp_path / "c.mp4", _moving_shadow(), 30)
     code, _, err = run_cli("stplot", clip, "--png", tmp_path / "auto.png")
     assert code == 0, err
-    code, _, err = run_cli("stplot", clip, "--png", tmp_path / "given.png", "--gain", "0.975")
-    assert code == 0, err
-    auto, given = titles
-    for title in titles:
-        assert not re.search(r"(^|\s)x\d", title), title  # no bare 'x0.975'
-        assert re.search(r"colour gain \d[\d.e+-]* display range per code value", title), title
-    assert "automatic" in auto and "robust sigma" in auto
-    assert "colour gain 0.975 display range per code value (given with --gain; full scale \u00b10.51 code values)" in given
+    assert all("colour gain" not in t and max(map(len, t.split("\n"))) <= 100 for t in titles), titles
+    auto, given = stplot.scale_label(2.0), stplot.scale_label(0.975, automatic=False)
+    assert "automatic" in auto and "robust sigma" in auto and "\u00b10.25" in auto
+    assert "set with --gain" in given and "\u00b10.51" in given and "code values" in given

@@ -69,8 +69,10 @@ def test_snr_table_fits_80_columns(clip):
     path, _ = clip
     res = _wallcli("snr", path)
     assert res.returncode == 0, res.stderr
-    verdict, _title, *rest = res.stdout.splitlines()  # the verdict first, then the (unwrapped) title
-    assert verdict.startswith("Verdict: ") and all(len(line) <= 80 for line in [verdict, *rest])
+    # the headline figure first (issue 61), the verdict, then the (unwrapped) title
+    headline, verdict, _title, *rest = res.stdout.splitlines()
+    assert headline.startswith("column SNR ") and verdict.startswith("Verdict: ")
+    assert all(len(line) <= 80 for line in [headline, verdict, *rest])
     assert "block SNR dB" in res.stdout and "-0.0" not in res.stdout
 
 

@@ -210,7 +210,7 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         first = models["count"]
         rows = RowStream(tee, roi=roi, bins=first.bins, fps=first.fps, progress=progress, vertical=True,
                          register=options.shake)
-        tracker = TrackBuilder(first.fps)
+        tracker = TrackBuilder(first.fps, gaps=lambda: reader.gaps)  # no track across frames lost, as track's
         for t, row in rows:
             thumb.push(t, row)
             tracker.push(t, row[:first.bins])

@@ -323,6 +323,10 @@ class SnrAccumulator:
         if not self._ready:
             self._setup(planes)
             self._ready = True
+            from wallcli.snr.column import ColumnSnr
+
+            self.column = ColumnSnr(self.roi, fps=self.fps)  # the headline figure, same frames
+        self.column.push(planes)
         x = self._rgb(planes)
         x0, y0, w, h = self.roi
         shift = self._register(planes.y[y0:y0 + h, x0:x0 + w]) if self._shake is not None else None
@@ -471,6 +475,7 @@ def snr_report(acc: SnrAccumulator, *, source: str, fps: float, roi_mode: str, n
     top = res.scale(1)
     out = {
         "input": source,
+        "column_snr_db": acc.column.db() if getattr(acc, "column", None) is not None else None,
         "roi": list(res.roi),
         "frames": res.frames,
         "channels": list(CHANNELS),

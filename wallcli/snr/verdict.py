@@ -39,13 +39,14 @@ def snr_verdict(result: dict) -> dict:
     # every text quotes the figure the JSON gives (``snr_db``, at ``block``) and names its block:
     # the 1x1 figure it once quoted disagreed with the JSON (jumping.mp4: 6.5 dB said, 5.0 given);
     # the 1x1 row is the table's first, under this line
-    figure = f"green {format_db(top)} dB at {at}"
+    # named "block SNR": the headline figure above it (column SNR) is another one
+    figure = f"block SNR green {format_db(top)} dB at {at}"
     if signal:
-        text = f"a signal above the noise, best at {at} blocks (green {format_db(top)} dB)"
+        text = f"a signal above the noise, best at {at}: block SNR green {format_db(top)} dB"
     elif max(one, top) <= 0:
-        text = f"no signal above the noise at any block size ({figure})"
+        text = f"no signal at any block size ({figure})"
     else:
         # not "no signal": a broad, faint change (a jumper dims the whole wall a little) can sit
         # under pixel-level residue at every block size, and the plots' bins still show it
-        text = f"no wall signal shown: no gain from averaging ({figure})"
+        text = f"no wall signal ({figure}, no averaging gain)"
     return {"signal": signal, "block": k, "snr_db": top, "text": text, "why": WHY}

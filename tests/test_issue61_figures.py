@@ -1,0 +1,114 @@
+"""Issue 61 (1, 3, 8): one headline figure, printed first under its name by count, activity and
+snr, on the labels' scale; stplot's PNG with a short title, a colour scale and its seams explained,
+positions in fractions of the view as track's."""
+from __future__ import annotations
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from clips import write_clip
+from wallcli.snr import column
+
+
+def _planes(img):
+    return SimpleNamespace(y=img, u=None, v=None, kind="gray", width=img.shape[1], height=img.shape[0])
+
+
+def _shade(T, W, H, amp):
+    x = np.arange(W)[None, :]
+    centre = W * (0.5 + 0.35 * np.sin(2 * np.pi * 0.3 * np.arange(T) / 30.0))[:, None]
+    return 120.0 - amp * np.exp(-0.5 * ((x - centre) / (0.15 * W)) ** 2)  # (T, W)
+
+
+@pytest.mark.parametrize("amp,sigma", [(0.6, 2.0), (2.0, 2.0), (1.5, 4.0)])
+def test_column_snr_is_the_labels_definition(amp, sigma):
+    # the labels' snr_db: the clean column profile's change over the noise of one column's mean
+    T, W, H = 512, 64, 48
+    clean = _shade(T, W, H, amp)
+    g = clean - clean.mean(axis=0, keepdims=True)
+    g = g - g.mean(axis=1, keepdims=True)
+    truth = 10 * np.log10(np.mean(g * g) / (sigma ** 2 / H)) + column.CALIBRATION_DB
+    rng = np.random.default_rng(1)
+    tap = column.ColumnSnr(fps=30.0)
+    for t in range(T):
+        tap.push(_planes(clean[t][None, :] + sigma * rng.standard_normal((H, W))))
+    assert tap.db() == pytest.approx(truth, abs=1.0)
+
+
+def test_column_snr_of_noise_alone_is_under_zero():
+    rng = np.random.default_rng(2)
+    tap = column.ColumnSnr(fps=30.0)
+    for _ in range(300):
+        tap.push(_planes(100.0 + 3.0 * rng.standard_normal((40, 64))))
+    assert tap.db() < 0
+
+
+def test_column_text_names_its_figure_and_band():
+    assert column.column_text(16.9) == "column SNR 16.9 dB (labels' scale): plain in the plot"
+    assert column.column_text(-3.0).endswith("under the noise")
+    assert column.column_text(5.0).endswith("faint in the plot")
+
+
+@pytest.fixture(scope="module")
+def walker(tmp_path_factory):
+    path = tmp_path_factory.mktemp("c") / "walker.mp4"
+    shade = _shade(330, 48, 36, 6.0)
+    rng = np.random.default_rng(3)
+
+    def frame(i):
+        img = np.repeat(shade[i][None, :, None], 36, 0) + 1.5 * rng.standard_normal((36, 48, 1))
+        return np.repeat(img, 3, axis=2)
+
+    return write_clip(path, frame, 330)
+
+
+def test_count_prints_the_headline_first(run_cli, walker):
+    code, out, _ = run_cli("count", walker, "--json")
+    assert code == 0
+    db = json.loads(out)["column_snr_db"]
+    assert isinstance(db, float) and db > 10  # a plain shade
+    code, out, _ = run_cli("count", walker)
+    assert code == 0
+    title, header = out.splitlines()[:2]  # the title stays first (scripts grep it)
+    assert "; column SNR " in title and title.index("column SNR") < title.index(" dB")  # the first figure
+    assert "signal_db" in header.split()  # the table's figure says which one it is
+
+
+def test_snr_prints_the_headline_first(run_cli, walker):
+    code, out, _ = run_cli("snr", walker, "--json")
+    assert code == 0
+    obj = json.loads(out)
+    assert obj["column_snr_db"] > 10 and "snr_db" in obj  # added, none renamed
+    code, out, _ = run_cli("snr", walker)
+    lines = out.splitlines()
+    assert lines[0].startswith("column SNR ") and lines[1].startswith("Verdict: ") and "block SNR" in lines[1]
+
+
+def test_stplot_png_title_scale_and_units(tmp_path, walker):
+    from PIL import Image
+
+    from wallcli.infer.classify import load_plot
+    from wallcli.plots import stplot
+
+    plot = load_plot(walker)
+    plot.meta["source"] = "a/rather/long/folder/name/of/the/kind/people/keep/their/recordings/in/" + "x" * 40 + ".mp4"
+    png = tmp_path / "p.png"
+    stplot.save_stplot_png(png, plot)
+    w, h = Image.open(png).size
+    assert w <= 1260  # the title no longer widens the figure (it was over 1500 px)
+    assert "gain" not in stplot.stplot_title("a.mp4", 2.0)
+    assert "code values" in stplot.scale_label(2.0)
+    assert "key frames" in stplot.SEAMS
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1)
+    stplot.draw_stplot(axes, plot)
+    assert axes[0].get_ylim() == (1.0, 0.0)  # fractions of the view, as track's x
+    assert "0 = view's left" in axes[0].get_ylabel()
+    plt.close(fig)

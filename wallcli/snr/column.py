@@ -1,0 +1,128 @@
+"""The headline figure, ``column_snr_db``: how far a person's light stands above the camera's noise
+in one column of the wall (the unit a space-time plot is made of), in dB.
+
+It is measured to mean what the labels' ``snr_db`` of the rendered recordings means (their
+generator's definition: the clean column profile's change over time, squared, over the noise of
+one column's mean in one frame), so that the README's bands read the same on a label and on an
+output: under 0 dB a person is under the noise, from 10 dB up plain in the plot.
+
+Measured on the luma of every column of the region, per chunk of CHUNK frames:
+- each column's mean over the chunk is removed, and so is the whole wall's common change in each
+  frame (the mean over the columns: a light's flicker or drift, which an empty room shows too);
+- noise = the columns' power at frequencies above NOISE_HZ, where a person's light is not (the
+  median over columns and frequencies, for the chi-square's median), taken as white;
+- signal = the chunk's whole power less that noise.
+The chunks' powers are summed, so a clip's figure weighs every frame alike and memory stays flat.
+
+CALIBRATION_DB: the labels measure the person's change in linear light, before the camera's tone
+curve (which compresses it: about 6.8 dB at a gamma of 2.2), and with the whole-wall dimming a
+person makes; this figure reads the decoded codes. The constant is the median difference on the
+191 rendered recordings with people (8.2 dB); research/snr/README.md gives the agreement.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+CHUNK = 256  # frames (8.5 s at 30 fps, a model window)
+NOISE_HZ = 6.0  # walking, crouching, waving and jumping live under 2.5 Hz
+CALIBRATION_DB = 8.0
+FLOOR_DB = -30.0
+_MEDIAN_CHI2_2 = np.log(2.0)  # a periodogram bin's median over its mean, for white noise
+NAME = "column SNR"  # what every terminal calls it
+
+
+def _luma(planes, roi) -> np.ndarray:
+    """The region's column means of one frame (float64, one per column)."""
+    x, y, w, h = roi
+    if getattr(planes, "kind", "yuv") == "rgb":  # y, u, v hold R, G, B
+        img = (planes.y[y:y + h, x:x + w].astype(np.float64) + planes.u[y:y + h, x:x + w]
+               + planes.v[y:y + h, x:x + w]) / 3.0
+    else:
+        img = planes.y[y:y + h, x:x + w].astype(np.float64)
+    return img.mean(axis=0)
+
+
+def chunk_powers(cols: np.ndarray, fps: float) -> tuple[float, float, int]:
+    """(signal power, noise power, samples) of a (T, columns) chunk of column means; powers are
+    summed over the chunk's samples (divide by the samples for a mean)."""
+    T = cols.shape[0]
+    if T < 8 or cols.shape[1] < 1:
+        return 0.0, 0.0, 0
+    g = cols - cols.mean(axis=0, keepdims=True)
+    g = g - g.mean(axis=1, keepdims=True)  # the whole wall's common change
+    f = np.fft.rfftfreq(T, 1.0 / fps)
+    high = f > min(NOISE_HZ, 0.5 * f[-1])
+    taper = np.hanning(T)
+    spec = np.abs(np.fft.rfft(g * taper[:, None], axis=0)) ** 2 / np.sum(taper * taper)
+    noise = float(np.median(spec[high])) / _MEDIAN_CHI2_2 if high.any() else 0.0
+    total = float(np.mean(g * g))
+    return (total - noise) * T, noise * T, T
+
+
+def to_db(signal: float, noise: float) -> float | None:
+    """The figure from summed powers: None when nothing was measured."""
+    if noise <= 0:
+        return None
+    ratio = max(signal / noise, 1e-30)
+    return round(max(10.0 * np.log10(ratio) + CALIBRATION_DB, FLOOR_DB), 2)
+
+
+class ColumnSnr:
+    """A frame tap (:class:`wallcli.io.video.FrameTee`): feed decoded frames, read :meth:`db`."""
+
+    wants_fps = True  # classify_video tells it the video's frame rate
+
+    def __init__(self, roi=None, fps: float | None = None):
+        self.requested, self.fps = roi, fps
+        self.roi = None
+        self._rows: list[np.ndarray] = []
+        self.signal = self.noise = 0.0
+        self.samples = 0
+
+    def __call__(self, frame) -> None:
+        self.push(frame.planes)
+
+    def push(self, planes) -> None:
+        if self.roi is None:
+            from wallcli.signal.blocks import check_roi
+
+            self.roi = check_roi(self.requested, planes.width, planes.height)
+        self._rows.append(_luma(planes, self.roi))
+        if len(self._rows) >= CHUNK:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self._rows:
+            s, n, t = chunk_powers(np.stack(self._rows), float(self.fps or 30.0))
+            self.signal, self.noise, self.samples = self.signal + s, self.noise + n, self.samples + t
+        self._rows = []
+
+    def db(self) -> float | None:
+        # a short tail joins the figure only if it can hold frequencies above NOISE_HZ
+        self._flush()
+        return to_db(self.signal, self.noise)
+
+
+def plot_column_snr_db(plot) -> float | None:
+    """The figure from a space-time plot (a .npz): its horizontal bins stand for columns, their
+    noise scaled up by the columns each bin averages (``meta['roi']``), as independent noise is."""
+    h = np.asarray(plot.horizontal, np.float64).mean(axis=-1).T  # (T, bins)
+    t = np.asarray(plot.time, np.float64)
+    fps = (len(t) - 1) / (t[-1] - t[0]) if len(t) > 1 and t[-1] > t[0] else 30.0
+    signal = noise = 0.0
+    for i in range(0, h.shape[0], CHUNK):
+        s, n, _ = chunk_powers(h[i:i + CHUNK], fps)
+        signal, noise = signal + s, noise + n
+    roi = (plot.meta or {}).get("roi")
+    per_bin = max(float(roi[2]) / h.shape[1], 1.0) if roi else 1.0
+    return to_db(signal, noise * per_bin)
+
+
+def column_text(db) -> str:
+    """The headline as a terminal prints it first, naming its figure and band."""
+    from wallcli.wording import format_db
+
+    if db is None:
+        return f"{NAME}: not measured"
+    band = ("under the noise" if db < 0 else "faint in the plot" if db < 10 else "plain in the plot")
+    return f"{NAME} {format_db(db)} dB (labels' scale): {band}"
