@@ -149,3 +149,13 @@ def test_follow_says_a_file_truncated_or_overwritten_and_exits_1(tmp_path, how):
     assert proc.returncode == 1, err
     assert lines[-1].startswith("Error:") and ("shrank" in lines[-1] or "replaced" in lines[-1]), err
     assert "Traceback" not in err
+
+
+def test_the_reports_tracks_end_at_a_gap_too(tmp_path):
+    from wallcli.report.analysis import analyse, load_models
+
+    a = analyse(str(_gappy(tmp_path / "gap.mkv", 2.03)), models=load_models())
+    assert a.tracks["tracks"]
+    for k in a.tracks["tracks"]:
+        ts = np.array([s["t"] for s in k["samples"]])
+        assert not ((ts > 89 / 30 + 1e-3) & (ts < 5.0 - 1e-3)).any()
