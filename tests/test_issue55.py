@@ -213,13 +213,16 @@ def test_scan_inputs_name_a_hard_linked_pair_once(tmp_path):
     assert expand_inputs([str(tmp_path)]) == [str(tmp_path / "a.mp4")]
 
 
-def test_report_counts_one_recording_under_two_names_once(tmp_path):
-    from wallcli.report.scan import read_results
+def test_report_shows_one_recording_under_two_names_as_a_copy(tmp_path):
+    # issue 62 (8): every file scanned is a row; merging them by sha256 hid files
+    from wallcli.report.scan import read_results, summarise
 
-    line = {"input": "a.mp4", "size": 1, "sha256": "ab" * 32, "tasks": ["snr"], "error": None}
+    line = {"input": "a.mp4", "size": 1, "sha256": "ab" * 32, "tasks": ["snr"], "error": None,
+            "snr": {"snr_db": [1.0, 1.0, 1.0]}}
     (tmp_path / "r.jsonl").write_text(json.dumps(line) + "\n" + json.dumps({**line, "input": "b.mp4"}) + "\n")
     records, problems = read_results(tmp_path / "r.jsonl")
-    assert [r["input"] for r in records] == ["b.mp4"] and "same sha256" in problems[0]
+    assert [r["input"] for r in records] == ["a.mp4", "b.mp4"] and "same sha256" in problems[0]
+    assert [r["copy_of"] for r in summarise(records)["rows"]] == [None, "a.mp4"]
 
 
 # 10 --------------------------------------------------------------------- evidence and leftovers

@@ -29,14 +29,12 @@ def _identity(path) -> tuple[int, int] | None:
     return st.st_dev, st.st_ino
 
 
-def _walk(folder: str, globs: list[str] | None, skip: tuple[int, int] | None = None) -> list[str]:
+def _walk(folder: str, globs: list[str] | None) -> list[str]:
     found = []
     for root, dirs, files in os.walk(folder):
         # hidden entries: editors' and wallcli's own temporaries (.NAME.XXXX.tmp.mp4), .git
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         found += [os.path.join(root, f) for f in sorted(files) if not f.startswith(".") and _matches(f, globs)]
-    if skip is not None:
-        found = [f for f in found if _identity(f) != skip]
     return found
 
 
@@ -54,15 +52,20 @@ def _read_list(arg: str) -> list[str]:
     return [s for s in (line.strip() for line in text.splitlines()) if s and not s.startswith("#")]
 
 
-def expand_inputs(args: list[str], globs: list[str] | None = None, skip: str | os.PathLike | None = None) -> list[str]:
+def expand_inputs(args: list[str], globs: list[str] | None = None, skip: str | os.PathLike | None = None,
+                  skipped_as: list[str] | None = None) -> list[str]:
     """The videos named by ``args``, in order, each once.
 
     A folder gives the files under it whose names match ``globs`` (default: the usual video
     extensions, any case); a file or URL is taken as is; ``@list.txt`` gives its lines. A path on
     the command line that does not exist is an error (a typo should not cost a run), and so is
     finding no video at all. A file found in a folder that is ``skip`` (the results file, which
-    may lie among the videos) is left out.
+    may lie among the videos) is left out, and the names it was found under are added to
+    ``skipped_as``: the caller decides whether it is the results file or a video it must not
+    overwrite.
     """
+    from wallcli.errors import UsageError
+
     skipped = _identity(skip) if skip is not None else None
     out: list[str] = []
     seen: set = set()
@@ -76,16 +79,21 @@ def expand_inputs(args: list[str], globs: list[str] | None = None, skip: str | o
             out.append(source)
 
     for arg in args:
-        if arg == "-":
-            raise WallcliError("scan reads files, folders, URLs and @lists, not '-' "
-                               "(a stream on stdin cannot be resumed or shared between workers)")
+        if arg == "-":  # a usage error: no stdin would do
+            raise UsageError("scan reads files, folders, URLs and @lists, not '-' "
+                             "(a stream on stdin cannot be resumed or shared between workers)")
         if arg.startswith("@"):
             for entry in _read_list(arg):
                 add(entry)
         elif is_url(arg):
             add(arg)
         elif os.path.isdir(arg):
-            found = _walk(arg, globs, skipped)
+            found = _walk(arg, globs)
+            if skipped is not None:
+                hits = [f for f in found if _identity(f) == skipped]
+                found = [f for f in found if f not in hits]
+                if skipped_as is not None:
+                    skipped_as += hits
             if not found:
                 empty_folders.append(arg)
             for f in found:

@@ -8,20 +8,18 @@ at most one torn last line, which the next run drops. On that next run, lines of
 unchanged (same sha256), scanned for the same tasks, with the same options (each line records them
 under "options") and the same models are kept and their videos skipped; errors, videos that
 changed and lines made with other options or models are done again and their old lines dropped,
-so each video keeps exactly one line. Rewriting the file (--force, or dropping such lines) waits
-for the run's first new line: a run that ends before one leaves the file as it was.
+so each video keeps exactly one line. Writing it is resultsfile.py's part; what a line may hold,
+validate.py's.
 """
 from __future__ import annotations
 
 import csv
-import errno
 import io
 import json
 import os
-import stat
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from wallcli.errors import WallcliError
 from wallcli.io import jsonfile
@@ -62,13 +60,31 @@ def csv_columns(tasks, classes: dict[str, list], windows: bool = False) -> list[
     return cols + ["view.usable", "view.issues", "view.reason", "view.notes"]
 
 
+# a spreadsheet runs a cell that begins with one of these as a formula (=1+2, @SUM(A1), -2+3; a
+# tab or CR before them is skipped): OWASP's "CSV injection" advice is a leading quote, which
+# makes the cell text. A text cell that begins with a quote gets one too, so that reading back
+# (a resume) strips exactly one: every name survives the round trip
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r", "'")
+
+
+def defuse(text: str) -> str:
+    """A text cell that no spreadsheet takes for a formula; :func:`undefuse` gives ``text`` back."""
+    return "'" + text if text.startswith(FORMULA_STARTS) else text
+
+
+def undefuse(cell: str) -> str:
+    return cell[1:] if cell.startswith("'") else cell
+
+
 def _cell(value: Any) -> str:
     if value is None:
         return ""
     if isinstance(value, bool):
         return "true" if value else "false"
-    if isinstance(value, (int, float, str)):
-        return str(value)
+    if isinstance(value, (int, float)):
+        return str(value)  # a number stays a number: -3.5 is no formula, and no quote is put before it
+    if isinstance(value, str):
+        return defuse(value)  # file names, reasons, errors: anyone's text
     return json.dumps(value, ensure_ascii=False)  # lists of objects (windows, scales), warnings
 
 
@@ -128,13 +144,20 @@ def _models(d: dict) -> dict:
             if isinstance(d.get(t), dict) and isinstance(d[t].get("model"), dict)}
 
 
-def _entry_json(raw: str) -> Entry | None:
+def _entry_json(raw: str) -> Entry | str:
+    """The entry of one stored line, or why it cannot be a line of scan's (the validator
+    ``wallcli report`` runs too)."""
+    from wallcli.batch.validate import line_problem
+
     try:
         d = jsonfile.loads(raw, allow_nan=True)
-    except json.JSONDecodeError:
-        return None
-    if not isinstance(d, dict) or not isinstance(d.get("input"), str) or not isinstance(d.get("tasks"), list):
-        return None
+    except json.JSONDecodeError as exc:
+        return f"not JSON ({exc.msg})"
+    why = line_problem(d)
+    if why is None and not isinstance(d.get("tasks"), list):
+        why = 'no "tasks" list'  # every line scan ever resumed records its tasks
+    if why is not None:
+        return why
     options = d.get("options") if isinstance(d.get("options"), dict) else None
     view = d.get("view") if isinstance(d.get("view"), dict) else None
     return Entry(raw, d["input"], d.get("size"), d.get("sha256"), tuple(d["tasks"]), d.get("error"), options,
@@ -156,14 +179,14 @@ def _entry_csv(row: list[str], header: list[str]) -> Entry | None:
     models = {t: d[f"{t}.model.sha256"] for t in ("count", "activity") if d.get(f"{t}.model.sha256")}
     view = None
     if d.get("view.usable"):
-        view = {"usable": d["view.usable"] == "true", "reason": d.get("view.reason") or None}
-    return Entry(csv_record(row)[:-1], unescape_surrogates(d["input"]), size, d["sha256"] or None,
-                 tuple(t for t in d["tasks"].split(",") if t), d["error"] or None,
+        view = {"usable": d["view.usable"] == "true", "reason": undefuse(d.get("view.reason") or "") or None}
+    return Entry(csv_record(row)[:-1], unescape_surrogates(undefuse(d["input"])), size, d["sha256"] or None,
+                 tuple(t for t in d["tasks"].split(",") if t), undefuse(d["error"]) or None,
                  options if isinstance(options, dict) else None, models, view)
 
 
-def _not_ours(path: Path, n: int) -> WallcliError:
-    return WallcliError(f"{path} line {n} is not a wallcli scan result",
+def _not_ours(path: Path, n: int, why: str | None = None) -> WallcliError:
+    return WallcliError(f"{path} line {n} is not a wallcli scan result" + (f": {why}" if why else ""),
                         hint="choose another -o, or --force to replace the file")
 
 
@@ -221,159 +244,7 @@ def read(path: Path, columns: list[str] | None) -> tuple[list[Entry], bool]:
         if not raw.strip():
             continue
         e = _entry_json(raw)
-        if e is None:
-            raise _not_ours(path, n)
+        if isinstance(e, str):
+            raise _not_ours(path, n, e)
         entries.append(e)
     return entries, torn
-
-
-# ------------------------------------------------------------------------------------- writing
-class ResultsFile:
-    """The results file of one run: :meth:`open` (and lock) it before reading it, :meth:`start`
-    appending, :meth:`append` a line per video, :meth:`close` (or :meth:`abandon`) at the end."""
-
-    def __init__(self, path: Path, encode: Callable[[dict], str], columns: list[str] | None = None):
-        self.path, self.encode, self.columns = Path(path), encode, columns
-        self.created = False  # by this run: removed again if the run fails before its first line
-        self.appended = 0
-        self._fd: int | None = None
-        self._fh = None
-        self._pending: list[Entry] | None = None  # lines the file is to be replaced by (start)
-
-    def open(self) -> None:
-        """Open the file, creating it if absent, and take its lock; a scan already holding it is
-        an error, at once (a batch that waited would only redo that scan's work)."""
-        flags = os.O_RDWR | os.O_APPEND | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
-        for _ in range(20):
-            try:
-                try:
-                    fd = os.open(self.path, flags | os.O_CREAT | os.O_EXCL, 0o666)
-                    created = True
-                except FileExistsError:
-                    fd = os.open(self.path, flags)  # O_NONBLOCK: a FIFO put there meanwhile must not hang us
-                    created = False
-            except FileNotFoundError:
-                continue  # removed between the two opens: try again
-            except OSError as exc:
-                raise WallcliError(f"cannot open {self.path}: {_reason(exc)}") from None
-            if not stat.S_ISREG(os.fstat(fd).st_mode):
-                os.close(fd)
-                raise WallcliError(f"{self.path} is not a regular file; scan results go to a file")
-            try:
-                _lock(fd, self.path)
-            except BaseException:
-                os.close(fd)
-                raise
-            try:
-                same = os.path.samestat(os.stat(self.path), os.fstat(fd))
-            except OSError:
-                same = False
-            if same:
-                self._fd, self.created = fd, created
-                return
-            # the scan that held the lock replaced or removed the file before letting go: the lock
-            # taken is on a file no longer there; the one at the path now is the one to lock
-            os.close(fd)
-        raise WallcliError(f"cannot lock {self.path}: it keeps being replaced (another scan?)")
-
-    def _format(self, line: dict) -> str:
-        if self.columns is None:
-            return self.encode(line) + "\n"
-        return csv_record(flatten(line, self.columns))
-
-    def start(self, kept: list[Entry] | None) -> None:
-        """Start appending. ``kept`` None: the file is right as it is; otherwise it is to be
-        replaced, atomically, by a fresh file holding the header and ``kept``'s lines, but only
-        once this run stores its first line or ends well: a run that fails or is interrupted
-        before that (an unreachable cluster, Ctrl-C at start-up) leaves the old file as it was,
-        --force's old results included."""
-        self._pending = kept
-        if kept is None:
-            self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
-
-    def _replace(self) -> None:
-        from wallcli.io.writer import atomic_path, release_temporary
-
-        kept, self._pending = self._pending, None
-        header = [csv_record(self.columns)] if self.columns is not None else []
-        new = None
-        try:
-            with atomic_path(self.path, force=True) as tmp:
-                tmp.write_text("".join(header + [f"{e.raw}\n" for e in kept]), encoding="utf-8")
-                # locked before the rename, and the lock goes with the file: there is no moment
-                # when the path names an unlocked file another scan could take
-                new = os.open(tmp, os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0))
-                release_temporary(tmp)  # the writer's own lock on it gives way to this one
-                _lock(new, self.path)
-        except OSError as exc:
-            if new is not None:
-                os.close(new)
-            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
-        except BaseException:
-            if new is not None:
-                os.close(new)
-            raise
-        os.close(self._fd)
-        self._fd = new
-        self._fh = os.fdopen(self._fd, "a", encoding="utf-8", newline="")
-
-    def append(self, line: dict) -> None:
-        if self._pending is not None:
-            self._replace()
-        # one write of the whole line, then flush and fsync: the line is on disk before the next
-        # one starts, and a kill can tear at most the line being written
-        try:
-            self._fh.write(self._format(line))
-            self._fh.flush()
-            os.fsync(self._fh.fileno())
-        except OSError as exc:  # a full disk, a quota: the lines before this one are whole
-            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
-        self.appended += 1
-
-    def close(self) -> None:
-        """End a run that went well: a replacement still pending (no line stored) is made now."""
-        if self._pending is not None and self._fd is not None:
-            self._replace()
-        fh, fd, self._fh, self._fd = self._fh, self._fd, None, None
-        try:
-            if fh is not None:
-                fh.close()
-            elif fd is not None:
-                os.close(fd)
-        except OSError as exc:
-            raise WallcliError(f"cannot write {self.path}: {_reason(exc)}") from None
-
-    def abandon(self) -> None:
-        """Close after a failure; a file this run created and never wrote a line to is removed
-        (while still locked, so no other scan can have opened it meanwhile)."""
-        self._pending = None  # the old file stays as it was: nothing new replaces it
-        try:
-            if self.created and not self.appended:
-                self.path.unlink(missing_ok=True)
-            self.close()
-        except (OSError, WallcliError):  # a full disk refuses the unwritten rest again: the first error tells
-            pass
-
-
-def _reason(exc: OSError) -> str:
-    text = exc.strerror or str(exc)
-    return text[:1].lower() + text[1:]
-
-
-def _lock(fd: int, path: Path) -> None:
-    """An exclusive advisory lock on the open file ``fd``; an error naming ``path`` when another
-    process holds one. flock, not lockf: a POSIX lock is dropped when the process closes *any*
-    descriptor of the file, as reading it does."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX: no lock, as before
-        return
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        raise WallcliError(f"another wallcli scan is writing {path}",
-                           hint="wait for it to end, or choose another -o") from None
-    except OSError as exc:
-        if exc.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS):
-            return  # a file system without locks (some network ones): carry on unlocked, as before
-        raise WallcliError(f"cannot lock {path}: {_reason(exc)}") from None

@@ -41,6 +41,16 @@ def _unchanged(source: str, entry) -> bool:
         return False
 
 
+def _holds_results(path: Path, columns) -> bool:
+    """Is ``path`` (found in a scanned folder) a results file of scan's, resumable or empty?"""
+    from wallcli.batch.results import read
+
+    try:
+        return path.stat().st_size == 0 or read(path, columns) is not None
+    except (OSError, WallcliError):
+        return False
+
+
 def same_making(entry, options: dict | None, models: dict | None) -> bool:
     """Was ``entry``'s line made as this run would make it: the same options (a line that does not
     record them is from an older wallcli: made again) and, per classification task, the same model?"""
@@ -104,19 +114,27 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
     mismatched workers, interruption); a video's own failure is its error line.
     """
     from wallcli.batch.engine import Engine
-    from wallcli.batch.inputs import expand_inputs, is_url
-    from wallcli.batch.results import ResultsFile, csv_columns, is_csv
+    from wallcli.batch.inputs import VIDEO_EXTENSIONS, expand_inputs, is_url
+    from wallcli.batch.results import csv_columns, is_csv
+    from wallcli.batch.resultsfile import ResultsFile
     from wallcli.batch.task import ScanConfig, identity, scan_video
     from wallcli.io.writer import check_output
 
     tasks = tuple(t for t in TASKS if t in tasks)
+    if Path(output).name.lower().endswith(VIDEO_EXTENSIONS):  # a slip that would put JSON over a video
+        raise UsageError(f"-o {output} is named as a video; scan writes its results to a .jsonl or .csv file, "
+                         "never to a video name, --force or not")
     # the results file inside a scanned folder is not a video: running the command again resumes
-    sources = expand_inputs([str(i) for i in inputs], globs, skip=Path(output))
+    picked: list[str] = []
+    sources = expand_inputs([str(i) for i in inputs], globs, skip=Path(output), skipped_as=picked)
     from wallcli.infer.model import shipped_model_path
 
     out = check_output(output, force=True, inputs=[*(s for s in sources if not is_url(s)),
                                                    *(shipped_model_path(t) for t in CLASSIFY if t in tasks)])
     columns = csv_columns(tasks, _classes(tasks), windows) if is_csv(out) else None
+    if picked and not _holds_results(out, columns):  # what --glob picks up is a video to scan, not to overwrite
+        raise WallcliError(f"output {out} is one of the inputs (found as {picked[0]}); wallcli never overwrites "
+                           "an input, --force or not", hint="write the results elsewhere, or narrow --glob")
     results = ResultsFile(out, encode, columns)
     results.open()  # and locked: from here to the end, no other scan writes it
     ok = failed = 0
@@ -141,7 +159,7 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
         on_start(len(todo), skipped)
         config = ScanConfig(tasks=tasks, windows=windows, timeout=timeout, expected=identity(),
                             deflicker=deflicker, exposure=exposure, shake=shake)
-        results.start(kept)
+        results.start(kept, force=force)
         t0 = time.perf_counter()
         if todo:
             def failed_line(source: str, message: str) -> dict:
@@ -164,6 +182,8 @@ def run_scan(inputs: list[str], output: str | os.PathLike, *, tasks=TASKS, worke
                     on_line(line)
     except BaseException:
         results.abandon()  # a run that failed before its first line leaves no file it created
+        if results.note:  # what became of --force's new lines
+            log(results.note)
         raise
     results.close()
     wall = time.perf_counter() - t0

@@ -17,7 +17,8 @@ def scan(
                                        metavar="INPUT"),
     output: Path = typer.Option(..., "-o", "--output", help="Results: JSON Lines (one object per video, see docs/contract.md), "
                                 "or flattened CSV when the name ends in .csv. An existing file is resumed; one scan "
-                                "at a time writes it (a second one exits 1).",
+                                "at a time writes it (a second one exits 1). Never a video's name, nor a file the "
+                                "inputs name or a folder's --glob picks up, --force or not.",
                                 show_default=False),
     task: str = typer.Option("count,activity,snr", "--task", help="Comma list of count, activity, snr: what each video is "
                              "asked. All come from one decode of the video."),
@@ -29,7 +30,9 @@ def scan(
     glob: Optional[List[str]] = typer.Option(None, "--glob", help="File names to take from folders, e.g. '*.mp4' "
                                              "(repeatable). Default: the usual video extensions, any case."),
     force: bool = typer.Option(False, "--force", help="Start the results file again (every video redone) instead of "
-                               "resuming it. The old file stays as it is until the first new line replaces it."),
+                               "resuming it. The old results stay whole until the run ends (the new lines go to a "
+                               "hidden file beside them); a run interrupted or failed after some new lines merges "
+                               "them into the old results."),
     windows: bool = typer.Option(False, "--windows", help="Keep every window's answer in count and activity "
                                  "(the lines grow by a few hundred bytes per 2 s of video)."),
     timeout: float = number_option(300.0, "--timeout", lo=0, hi=86400, help="Give a video up (an error line) when its decoder "

@@ -2,7 +2,9 @@
 
 A scan writes and flushes one line per video as it finishes, so a killed scan leaves a file
 whose last line may be cut short; a line that is not a JSON object becomes a row carrying that
-error instead of stopping the summary.
+error instead of stopping the summary. A line that is an object but holds what scan never writes
+(a negative duration, NaN probabilities, a task's answer replaced by null) is refused, as a
+resume of that file refuses it: the page would show it as an answer.
 """
 from __future__ import annotations
 
@@ -13,12 +15,14 @@ from typing import Any
 
 import numpy as np
 
+from wallcli.batch.validate import line_problem
 from wallcli.errors import WallcliError
 from wallcli.io import jsonfile
 from wallcli.report.verdicts import answer
 
 TASKS = ("count", "activity")
 _STAND_IN = "_wallcli_stand_in"  # marks the record made for a line that is not one
+_COPY_OF = "_wallcli_copy_of"  # the input of the first line with the same sha256
 
 
 def _num(x) -> float | None:
@@ -49,6 +53,11 @@ def read_results(path: str | Path) -> tuple[list[dict[str, Any]], list[str]]:
         if not isinstance(rec, dict):
             problems.append(f"{path}: {why}")
             rec = {"input": f"(line {n})", "error": why, _STAND_IN: True}
+        else:
+            impossible = line_problem(rec)
+            if impossible:
+                raise WallcliError(f"{path} line {n} is not a wallcli scan result: {impossible}",
+                                   hint="report reads the lines 'wallcli scan' writes")
         records.append(rec)
     if not records:
         raise WallcliError(f"{path} holds no results (expected one JSON object per line, as 'wallcli scan' writes)")
@@ -68,14 +77,21 @@ def _once_each(records: list[dict[str, Any]], path, problems: list[str]) -> list
     if repeated:
         problems.append(f"{path}: {repeated} video{'s' if repeated != 1 else ''} appear on more than one line; "
                         "the last line of each is counted")
-    # one recording under two names (a hard link, a copy; an older scan scanned both): one video
-    shas = [r.get("sha256") if isinstance(r.get("sha256"), str) and r.get("sha256") else None for r in kept]
-    last_sha = {s: i for i, s in enumerate(shas) if s is not None}
-    twice = len({s for i, s in enumerate(shas) if s is not None and last_sha[s] != i})
-    if twice:
-        problems.append(f"{path}: {twice} recording{'s' if twice != 1 else ''} appear under more than one name "
-                        "(the same sha256); the last line of each is counted")
-        kept = [r for i, (r, s) in enumerate(zip(kept, shas)) if s is None or last_sha[s] == i]
+    # one recording under two names (a hard link, a copy): each file scanned is a row, the later
+    # ones marked as copies of the first (merging them hid files: 4 copies of 6 clips read 7 videos)
+    first: dict[str, str] = {}
+    copies = 0
+    for r in kept:
+        sha = r.get("sha256") if isinstance(r.get("sha256"), str) and not r.get(_STAND_IN) else None
+        if sha:
+            if sha in first:
+                r[_COPY_OF] = first[sha]
+                copies += 1
+            else:
+                first[sha] = str(r.get("input"))
+    if copies:
+        problems.append(f"{path}: {copies} of the videos {'are copies' if copies != 1 else 'is a copy'} of another "
+                        "(the same sha256): each is a row, marked as a copy")
     return kept
 
 
@@ -111,7 +127,7 @@ def _row(rec: dict[str, Any]) -> dict[str, Any]:
         "snr_db": snr_figure(rec.get("snr")),
         "signal_db": {t: _signal(rec.get(t)) for t in TASKS},
         "count": tasks["count"], "activity": tasks["activity"],
-        "confident": confident, "error": error,
+        "confident": confident, "error": error, "copy_of": rec.get(_COPY_OF),
     }
 
 
@@ -127,6 +143,7 @@ def summarise(records: list[dict[str, Any]]) -> dict[str, Any]:
         "rows": rows,
         "totals": {
             "videos": len(rows), "ok": len(ok), "failed": len(rows) - len(ok),
+            "copies": sum(r["copy_of"] is not None for r in rows),
             "duration": sum(r["duration"] or 0.0 for r in ok),
             "frames": int(sum(r["frames"] or 0 for r in ok)),
             "size": sum(r["size"] or 0 for r in rows),
