@@ -14,6 +14,13 @@ import math
 COUNT_COUNTS = "count counts the people who move: a person standing still counts 0"
 
 
+# evaluate's by_band names (CONTRACT.md: "empty", "<0 dB", ...) as its table and figure say them.
+# "empty" holds every clip where nobody moves, a person standing still included (standing.mp4):
+# "empty rooms" said otherwise of a room with a person in it.
+BAND_TEXT = {"empty": "nobody moving", "<0 dB": "under 0 dB", "0-10 dB": "0-10 dB", ">=10 dB": "10 dB and over",
+             "not measured": "SNR unknown"}
+
+
 def format_db(x) -> str:
     """``x`` dB as text: '12.3', '0.0' (for -0.04 too), '-' when there is no finite number."""
     try:
@@ -36,6 +43,13 @@ def span_text(a: float, b: float) -> str:
 def plural(n: int, word: str, words: str | None = None) -> str:
     """'1 video', '2 videos' ('1 person', '3 people' with ``words``)."""
     return f"{n} {word if n == 1 else (words or word + 's')}"
+
+
+def frames_text(decoded: int, corrections=None) -> str:
+    """A clip's frames as every command says them: the frames decoded, and the repeats among them
+    left out of the analysis (the ``duplicates`` correction): '360 frames (1 repeat left out)'."""
+    dups = sum(int(c.get("frames") or 0) for c in corrections or () if c.get("kind") == "duplicates")
+    return f"{plural(int(decoded), 'frame')}" + (f" ({plural(dups, 'repeat')} left out)" if dups else "")
 
 
 def label_text(label) -> str:

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 from wallcli.cli.output import print_lines, print_table
 
-BAND_NAMES = {"empty": "empty rooms", "<0 dB": "under 0 dB", "0-10 dB": "0-10 dB", ">=10 dB": "10 dB and over",
-              "not measured": "SNR unknown"}
+from wallcli.wording import BAND_TEXT as BAND_NAMES  # the figure's words too (plots/reliability.py)
 
 
 def plural(n: int, noun: str) -> str:

@@ -21,12 +21,13 @@ def evaluate(
                                          "Default: the shipped model for --task."),
     json_out: bool = typer.Option(False, "--json", help="Print one JSON object on stdout (docs/contract.md), rows included."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw a reliability diagram (confidence of the clip "
-                                        "answers against how often they are right) and accuracy against measured "
-                                        "SNR to this PNG. " + PNG_NAME),
+                                        "answers against how often they are right; ECE, the calibration error, is "
+                                        "their mean gap, 0 = calibrated) and the clips right by band (the table's "
+                                        "bands, on its figure) to this PNG. " + PNG_NAME),
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
                               help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
-    min_snr: Optional[float] = number_option(None, "--min-snr", lo=-99, hi=99, help="Score only empty rooms and "
-                                             "clips whose SNR in dB (labels.csv's snr_db, else the answer's measured "
+    min_snr: Optional[float] = number_option(None, "--min-snr", lo=-99, hi=99, help="Score only clips where nobody "
+                                             "moves and clips whose SNR in dB (labels.csv's snr_db, else the answer's measured "
                                              "signal, signal_db) is at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG (the only file evaluate writes)")),
@@ -45,7 +46,7 @@ def evaluate(
     (same model, windows and stride; the answer's signal_db is the figure its reason
     quotes) and its block SNR measured too (snr_db: green channel, wallcli snr's estimator
     at the block size of one space-time plot bin). Prints first the clips right by band
-    (empty rooms, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db column where
+    (nobody moving, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db column where
     there is one, else on the answers' signal_db, the figure the decided/undetermined
     thresholds are per band of), accuracy with its exact 95 %
     interval (Clopper-Pearson, over clips), how many answers were decided (not
