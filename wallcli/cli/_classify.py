@@ -161,6 +161,39 @@ def _report(task, input, model, result, st, plot, json_out, force, *, verbose: b
         log(note)
 
 
+def decides_nothing(card: dict, single_stage: bool = False) -> bool:
+    """True while no cell of the card's trust thresholds holds a threshold (every one null, or no
+    thresholds at all): then no answer can be decided, whatever the clip."""
+    two = card.get("two_stage") if isinstance(card.get("two_stage"), dict) else {}
+    block = card.get("confidence") if single_stage or not two else two.get("confidence")
+    rows = block.get("thresholds") if isinstance(block, dict) else None
+    if not isinstance(rows, list):
+        return True
+    return all(t is None for row in rows for t in (row if isinstance(row, list) else [row]))
+
+
+NOTHING_DECIDED = ("Today no answer is decided: the shipped model's card sets no threshold that its "
+                   "validation backs, so every answer is undetermined (\"confident\": false), its label the "
+                   "model's best guess; read that as a guess, not a finding (README, 'What the answers "
+                   "mean'; docs/adapt.md earns decided answers on recordings of your own site).")
+
+
+def trust_help(task: str) -> str:
+    """The help's sentence on what may be relied upon, read from the shipped card at help time, so
+    that it says 'nothing is decided' exactly as long as that is true."""
+    import json
+    from importlib import resources
+
+    # as wallcli.infer.model.shipped_model_path finds it, without importing numpy at every start
+    try:
+        res = resources.files("wallcli.models") / f"{task}.json"
+        path = Path(str(res)) if res.is_file() else Path(__file__).resolve().parents[2] / "models" / f"{task}.json"
+        card = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, ModuleNotFoundError, TypeError):
+        return "Rely on decided answers only (\"confident\": true)."
+    return NOTHING_DECIDED if decides_nothing(card) else "Rely on decided answers only (\"confident\": true)."
+
+
 def accuracy_note(card: dict, single_stage: bool = False, unvalidated: str | None = None) -> str | None:
     """One line saying how far the model's answers can be trusted, from its card's validation.
 
@@ -186,7 +219,9 @@ def accuracy_note(card: dict, single_stage: bool = False, unvalidated: str | Non
         act = st.get("activity_model", {}) if st else {}
         how = f" in two stages (with {act.get('name', 'activity')} {act.get('version', '')})" if st else ""
         head = (f"{card.get('name', 'model')} {card.get('version', '')}{how}: right on {tr['accuracy']:.0%}{ci} of "
-                f"{tr['scored']} clips from an independent renderer{dec}. Rely on decided answers only.")
+                f"{tr['scored']} clips from an independent renderer{dec}. "
+                + ("No answer is decided today (its thresholds decide none): every label is a best guess."
+                   if decides_nothing(card, single_stage) else "Rely on decided answers only."))
         sim = _simulated_note(card)
         return head + (f" On simulated validation: {sim}" if sim else " See the model card.")
     sim = _simulated_note(card)

@@ -8,7 +8,7 @@ from wallcli.cli.common import stream_option, stall_option
 from wallcli.cli._classify import (ACTIVITY_MODEL_OPT, SINGLE_STAGE_OPT, FOLLOW_OPT, IDLE_OPT, FORCE_OPT, INPUT_ARG, JSON_OPT,
                                    MODEL_OPT, PLOT_OPT, ROI_OPT,
                                    STRICT_OPT, STRIDE_OPT, THREADS_OPT, NO_DEFLICKER_OPT, NO_EXPOSURE_OPT, NO_SHAKE_OPT,
-                                   VERBOSE_OPT, run)
+                                   VERBOSE_OPT, run, trust_help)
 
 
 def count(
@@ -48,6 +48,7 @@ def count(
 
     The table's title states the clip's answer, decided or undetermined, and the line under it
     why; -v (--verbose) adds, on stderr, how often the model was right in validation.
+    TRUST_NOW
 
     \b
     Examples:
@@ -61,3 +62,7 @@ def count(
         follow=follow, roi=roi, force=force, strict=strict,
         no_deflicker=no_deflicker, no_exposure=no_exposure, no_shake=no_shake, stream=stream, stall_timeout=stall_timeout,
         idle_timeout=idle_timeout, activity_model=activity_model, single_stage=single_stage, verbose=verbose)
+
+
+# said where the user reads it, for as long as it is true (the shipped card decides)
+count.__doc__ = count.__doc__.replace("TRUST_NOW", trust_help("count"))
