@@ -100,3 +100,16 @@ def test_an_activity_answer_checked_by_an_edited_count_card_is_unvalidated(tmp_p
     act = Model.load(shipped_model_path("activity"), task="activity")
     assert OnePersonActivity(act, Model.load(count, task="count")).unvalidated.startswith("unvalidated card")
     assert OnePersonActivity(act, Model.load(shipped_model_path("count"), task="count")).unvalidated is None
+
+
+def test_the_report_shows_no_figure_of_an_unvalidated_card(tmp_path):
+    from wallcli.infer.model import Model
+    from wallcli.report.cards import model_summary
+
+    model = _copy(tmp_path)
+    shown = model_summary(Model.load(model, task="count"))
+    assert shown["transfer"] and not any("unvalidated" in x for x in shown["limits"])
+    _edit(model, _zero_thresholds)
+    shown = model_summary(Model.load(model, task="count"))
+    assert not shown["transfer"] and not shown["simulated"] and not shown["by_snr"]
+    assert shown["limits"][0].startswith("Unvalidated card:")

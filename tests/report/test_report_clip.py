@@ -176,7 +176,9 @@ def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monke
     card["transfer"] = {"description": "clips of another renderer", "scored": 52, "accuracy": 0.9231, "ci95": [0.85, 0.97], "coverage": 0.8,
                         "accuracy_decided": 0.98, "command": "wallcli evaluate DIR --task count --json",
                         "renderer": "<b>path tracer</b>"}
-    (tmp_path / "count.json").write_text(json.dumps(card))
+    from wallcli.infer.card import card_text
+
+    (tmp_path / "count.json").write_text(card_text(card))  # sealed, as a program that measured it writes it
     import wallcli.io.video as video
 
     opened = []

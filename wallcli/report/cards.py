@@ -148,12 +148,17 @@ def model_summary(model) -> dict[str, Any]:
     own = card.get("limitations")
     own = [own] if isinstance(own, str) else [str(x) for x in own] if isinstance(own, list) else []
     onnx = card.get("onnx") if isinstance(card.get("onnx"), dict) else {}
+    unvalidated = getattr(model, "unvalidated", None)
+    if unvalidated:  # an edited card's figures are not the measured ones: none are shown (infer/trust.py)
+        sets, by_snr = [], []
+    first = [f"{unvalidated[:1].upper()}{unvalidated[1:]}: its validation figures are not shown and no answer "
+             "is decided."] if unvalidated else []
     return {
         "task": model.task, "name": card.get("name"), "version": card.get("version"), "sha256": card.get("sha256"),
         "path": str(model.path), "precision": onnx.get("precision"), "created": card.get("created"),
         "classes": [str(c) for c in model.classes], "window_s": model.window / model.fps,
         "simulated": [s for s in sets if s["accuracy"] is not None or s["visible_accuracy"] is not None],
         "by_snr": by_snr,
-        "transfer": _transfer(card.get("transfer")),
-        "limits": LIMITS.get(model.task, []) + [LEARNT if _shipped(model) else LEARNT_OWN] + own,
+        "transfer": None if unvalidated else _transfer(card.get("transfer")),
+        "limits": first + LIMITS.get(model.task, []) + [LEARNT if _shipped(model) else LEARNT_OWN] + own,
     }
