@@ -99,7 +99,11 @@ def _inside(d: Path, named: list[tuple[str, Clip]], source: Path | None = None) 
         if not target.is_relative_to(root):
             raise WallcliError(f"{row} names {c.file!r}, which is outside {d} (it leads to {target}); "
                                "put the clip itself (not a link to it) in the folder")
-        if target.exists() and not target.is_file():  # reading a FIFO or a device would block or never end
+        try:
+            special = target.exists() and not target.is_file()
+        except OSError:  # unreadable: that clip's row says why, later
+            special = False
+        if special:  # reading a FIFO or a device would block or never end
             raise WallcliError(f"{row} names {c.file!r}, which is {_kind(target)}, not a video file")
 
 
