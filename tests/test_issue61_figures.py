@@ -112,3 +112,39 @@ def test_stplot_png_title_scale_and_units(tmp_path, walker):
     assert axes[0].get_ylim() == (1.0, 0.0)  # fractions of the view, as track's x
     assert "0 = view's left" in axes[0].get_ylabel()
     plt.close(fig)
+
+
+def _capture(monkeypatch, module):
+    figs = []
+    monkeypatch.setattr(module, "save_figure", lambda fig, path, **kw: figs.append(fig))
+    return figs
+
+
+def test_snr_plot_draws_snr_in_db(monkeypatch, run_cli, walker, tmp_path):
+    # the tables give dB; the figure drew signal/noise as a ratio on a log axis (10^0-10^4)
+    from wallcli.plots import snr as plots
+
+    figs = _capture(monkeypatch, plots)
+    code, out, err = run_cli("snr", walker, "--json")
+    plots.save_scales_png(tmp_path / "s.png", json.loads(out))
+    ax = figs[0].axes[0]
+    assert ax.get_ylabel() == "block SNR (dB)" and ax.get_yscale() == "linear"
+    green = json.loads(out)["scales"]
+    assert list(ax.lines[2].get_ydata()) == pytest.approx([s["snr_db"][1] for s in green])
+    rows = [{"distance": d, "snr": v} for d, v in ((1.0, 100.0), (2.0, 0.1))]
+    plots.save_sweep_png(tmp_path / "w.png", "distance", rows)
+    sweep = figs[1].axes[0]
+    assert sweep.get_ylabel() == "predicted SNR (dB)"
+    assert list(sweep.lines[0].get_ydata()) == pytest.approx([20.0, -10.0])
+
+
+def test_count_plot_says_what_its_band_is_and_positions_are_fractions(monkeypatch, run_cli, walker, tmp_path):
+    from wallcli.plots import timeline
+
+    figs = _capture(monkeypatch, timeline)
+    code, _, err = run_cli("count", walker, "--plot", tmp_path / "t.png")
+    assert code == 0, err
+    ax_p, ax_h = figs[0].axes[:2]
+    labels = ax_p.get_legend_handles_labels()[1]
+    assert "one window" not in labels and any("each dot is the answer" in t for t in labels)
+    assert ax_h.get_ylim() == (1.0, 0.0) and "0 = view's left" in ax_h.get_ylabel()

@@ -56,17 +56,21 @@ def save_scales_png(path, result: dict, *, force: bool = False) -> None:
     sig = np.array([s["signal_power"] for s in result["scales"]], np.float64)
     noi = np.array([s["noise_power"] for s in result["scales"]], np.float64)
     for c, (name, colour) in enumerate(zip(result["channels"], COLOURS)):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            snr = np.where(sig[:, c] > 0, sig[:, c] / noi[:, c], np.nan)
+        # in dB, as every table and JSON field gives SNR (the JSON's scales[].snr_db)
+        snr = np.array([s["snr_db"][c] for s in result["scales"]], np.float64)
+        snr = np.where(np.abs(snr) < 99, snr, np.nan)  # +-99: nothing measurable
         ax_s.plot(blocks, snr, "o-", color=colour, label=f"{name} measured")
-        # White noise law: noise / pixels averaged, signal unchanged -> SNR x N^2.
+        # White noise law: noise / pixels averaged, signal unchanged -> SNR x N^2, +20 log10 N dB.
         if np.isfinite(snr[0]):
-            ax_s.plot(blocks, snr[0] * blocks**2, ":", color=colour, alpha=0.7, label=f"{name} white-noise law")
+            ax_s.plot(blocks, snr[0] + 20 * np.log10(blocks), ":", color=colour, alpha=0.7,
+                      label=f"{name} white-noise law")
         ax_n.plot(blocks, noi[:, c], "o-", color=colour, label=f"{name} measured")
         ax_n.plot(blocks, noi[0, c] / blocks**2, ":", color=colour, alpha=0.7, label=f"{name} noise(1) / N$^2$")
-    for ax, ylabel in ((ax_s, "SNR (signal / noise power)"), (ax_n, "noise power (code values$^2$)")):
+    ax_s.axhline(0.0, color="0.5", ls="--", lw=1)
+    for ax, ylabel in ((ax_s, "block SNR (dB)"), (ax_n, "noise power (code values$^2$)")):
         ax.set_xscale("log", base=2)
-        ax.set_yscale("log")
+        if ax is ax_n:
+            ax.set_yscale("log")
         ax.set_xlabel("block size N (N x N pixels averaged)")
         ax.set_ylabel(ylabel)
         ax.grid(True, which="both", alpha=0.3)
@@ -93,15 +97,17 @@ def save_sweep_png(path, key: str, rows: list[dict], *, force: bool = False) -> 
     x = np.array([r[key] for r in rows], np.float64)
     what = sweep_quantity(rows)
     if what == "SNR":
-        y, label = np.array([r["snr"] for r in rows]), "predicted SNR (signal / noise power)"
+        y = 10 * np.log10(np.maximum(np.array([r["snr"] for r in rows], np.float64), 1e-30))
+        label = "predicted SNR (dB)"
     else:
         y, label = np.array([r["signal_power"] for r in rows]), "predicted signal power (code values$^2$)"
     ax.plot(x, y, "o-")
-    if np.all(y > 0):
-        ax.set_yscale("log")
-        if what == "SNR" and y.min() < 1 < y.max():
-            ax.axhline(1.0, color="0.5", ls="--", lw=1, label="SNR = 1 (0 dB)")
+    if what == "SNR":
+        if y.min() < 0 < y.max():
+            ax.axhline(0.0, color="0.5", ls="--", lw=1, label="0 dB (signal = noise)")
             ax.legend(fontsize=8)
+    elif np.all(y > 0):
+        ax.set_yscale("log")
     name = key.replace("_", " ")
     ax.set_xlabel(f"{name} ({UNITS[key]})" if key in UNITS else name)
     ax.set_ylabel(label)
