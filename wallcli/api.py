@@ -147,6 +147,7 @@ def compute_plot(source, *, roi: Roi = None, bins: int = 64, mean: str = "clip",
     is a context manager yielding a callable advanced once per frame. A too-narrow ROI's warning is
     in ``meta["warnings"]``."""
     from wallcli.camera.pipeline import CameraPipeline
+    from wallcli.camera.tnr import TemporalNoise
     from wallcli.io.ahead import Ahead
     from wallcli.io.video import FrameTee, open_video
     from wallcli.signal.stplot import MODES, compute_stplot
@@ -157,14 +158,18 @@ def compute_plot(source, *, roi: Roi = None, bins: int = 64, mean: str = "clip",
     roi_t = _roi(roi)
     # the view check and the camera's shifts ride on the same decode: the .npz keeps both, so that
     # count and activity read from it answer as they would from the video (view verdict, shake)
-    check = ViewCheck(roi_t)
+    check, blend = ViewCheck(roi_t), TemporalNoise()
     with open_video(str(source), threads=threads) as reader:
         with progress("stplot", reader.info.frame_count) as advance:
             # repeats left out, interlaced fields at one instant, overlays masked, as count reads it
             # (its checks in a thread of their own, beside the projection: wallcli.io.ahead)
-            with Ahead(FrameTee(CameraPipeline(reader, check), (check,))) as frames:
+            # and the camera's blending of noise measured, as count measures it: the plot lists what
+            # the decode found (repeats, fields, noise reduction) as the video's answers list it
+            with Ahead(FrameTee(CameraPipeline(reader, check), (check, blend))) as frames:
                 plot = compute_stplot(frames, roi=roi_t, bins=bins, mean=mean, mean_seconds=mean_seconds,
                                       progress=advance, register=True, view=check)
+    if blend.correction():
+        plot.meta.setdefault("corrections", []).append(blend.correction())
     narrow = narrow_roi(plot.meta["roi"], plot.bins)
     if narrow:
         plot.meta.setdefault("warnings", []).append(narrow)

@@ -166,12 +166,14 @@ def _measure(input, *, roi, json_out, heatmap, heatmap_of, plot, max_pixels, for
     if not result["view"]["usable"]:  # the figures below then measure more than a wall's light
         warn(result["view"]["reason"])
     from wallcli.snr.column import column_text
+    from wallcli.wording import frames_text
 
     # the headline figure first, by its name; the verdict's and the table's are block SNRs
     print_lines([f"{column_text(result.get('column_snr_db'))}.", f"Verdict: {result['verdict']['text']}."])
     how = "every pixel" if res.exact else f"{res.sampled_pixels} pixels (32x32 tile lattice; --max-pixels 0 for all)"
     print_table(
-        f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), {res.frames} frames, {how}; "
+        f"{input}: ROI {','.join(map(str, res.roi))} ({result['roi_mode']}), "
+        f"{frames_text(result['frames'], result.get('corrections'))}, {how}; "
         "powers in 8-bit code values^2",
         ["block", "signal R G B", "noise R G B", "block SNR dB R G B"],
         [[f"{s['block']}x{s['block']}", _triple(s["signal_power"]), _triple(s["noise_power"]),

@@ -75,8 +75,9 @@ def stplot(
     with committed_together():  # the .npz, the PNG and the JSON: all or none
         _write(plot, input, output, png, style, gain, json_out, force)
     from wallcli.cli.output import wrote
+    from wallcli.wording import frames_text
 
-    shape = f"{plot.bins} positions x {plot.frames} frames"
+    shape = f"{plot.bins} positions x {frames_text(plot.decoded, plot.meta.get('corrections'))}"
     wrote((output, f"horizontal and vertical space-time plots, {shape}"), (png, "both plots, amplified"))
 
 
@@ -101,7 +102,7 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
         m = plot.meta
         emit_json({
             "input": input, "output": str(output) if output else None, "png": str(png) if png else None,
-            "frames": plot.frames, "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
+            "frames": plot.decoded, "corrections": m.get("corrections", []), "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
             "fps_source": m.get("fps_source", "container"), "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
             "signal_rms": [float(x) for x in channel_std(plot.horizontal)],
             "warnings": m.get("warnings", []),

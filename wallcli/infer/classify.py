@@ -35,7 +35,20 @@ def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Op
         from wallcli.view.check import ViewCheck
 
         result = with_view(result, ViewCheck.restore(view))
-    return result
+    return with_decode_findings(result, plot.meta)
+
+
+def with_decode_findings(result: dict[str, Any], meta: dict | None) -> dict[str, Any]:
+    """``result`` with what the decode of a plot's video found and took out (stplot keeps the camera
+    pipeline's corrections, repeats and fields, and the noise blending in ``meta["corrections"]``),
+    added as the video's own path adds them (:meth:`_Decode.result`): the same list, and no answer
+    decided on a signal_db that blending makes an upper bound."""
+    from wallcli.camera.tnr import bound_result
+
+    found = [dict(c) for c in (meta or {}).get("corrections") or []]
+    blended = [c for c in found if c["kind"] == "temporal_nr" and isinstance(c.get("lag1"), (int, float))]
+    result["corrections"] += [c for c in found if c["kind"] != "temporal_nr"]
+    return bound_result(result, blended[0] if blended else None)
 
 
 class WindowClassifier(WindowStream):

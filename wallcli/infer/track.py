@@ -60,6 +60,8 @@ def track_plot(plot, source: str, *, view_width: float | None = None):
         # the same view block as the video's (and count's on this file): its summary, not the raw record
         view = ViewCheck.restore(plot.meta["view"]).summary()
         extra["view"] = view
+    # what the video's decode found and took out (repeats, fields), as the video's track lists it
+    extra["corrections"] = [c for c in (plot.meta or {}).get("corrections") or [] if c["kind"] != "temporal_nr"]
     gaps = [tuple(g) for g in (view or {}).get("gaps", [])]
     result = track_result(source, track_rows(rows, t, fps, gaps=gaps), fps=fps, view_width=view_width,
                           extra=extra)

@@ -76,7 +76,7 @@ def plot_windows(model, plot, *, stride: int, source: str, corrections: corr.Opt
     offsets = {"horizontal": np.asarray(plot.h_mean, np.float32), "vertical": np.asarray(plot.v_mean, np.float32)}
     starts = run_window_starts(grid, model.fps, model.window, stride)  # none spans a gap
     if not starts:
-        raise too_short(source, plot.frames, model, rate)
+        raise too_short(source, getattr(plot, "decoded", plot.frames), model, rate)  # the video's frames, repeats too
     probs, signal, found = [], [], []
     native = rate
     for i in range(0, len(starts), CHUNK):

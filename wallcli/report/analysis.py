@@ -95,6 +95,11 @@ class _Tee:
             yield frame
 
 
+def _repeats(corrections: list[dict]) -> int:
+    """How many of the decoded frames were repeats left out (the ``duplicates`` correction)."""
+    return sum(int(c.get("frames") or 0) for c in corrections if c.get("kind") == "duplicates")
+
+
 def file_facts(source: str) -> dict[str, Any]:
     """Size, sha256 and modification time of a regular file; None for streams, URLs, devices."""
     from wallcli.infer.card import sha256_file
@@ -245,7 +250,10 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         "width": plot.meta["frame_size"][0], "height": plot.meta["frame_size"][1],
         "fps": fps, "fps_fraction": plot.meta.get("fps_fraction"),
         "declared_frames": info.frame_count, "declared_duration": info.duration,
-        "frames": rows.frames, "duration": float(tee.last) + 1.0 / fps,
+        # the frames decoded, repeats included (as snr, stplot and scan count them); the repeats left
+        # out of the analysis are the duplicates correction, said beside this count too
+        "frames": tee.pipeline.decoded, "repeats": _repeats(tee.pipeline.corrections()),
+        "duration": float(tee.last) + 1.0 / fps,
         "warnings": notes,
         "wallcli_version": __version__,
         "generated": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -262,7 +270,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         out.tracks = track_result(str(source), tracker.finish(), fps=float(fps))  # the video's rate
     for task, c in classifiers.items():
         try:
-            out.results[task] = bound_result(with_view(c.result(str(source), frames=rows.frames, fps=fps), tee.view),
+            result = c.result(str(source), frames=tee.pipeline.decoded, fps=fps)
+            out.results[task] = bound_result(with_view(result, tee.view),
                                              tee.blend.correction())
             out.results[task]["corrections"] += tee.pipeline.corrections()
         except WallcliError as exc:  # too short for one window: the rest of the report still stands

@@ -78,7 +78,8 @@ def clip_page(a, *, command: str) -> str:
         title=a.identity["path"], command=command, roi=list(a.roi), view_note=VIEW_NOTE,
         identity=dict(a.identity, container=container_name(a.identity.get("container"), a.identity.get("path"))),
         # the verdict `wallcli snr` leads with, on the page's own figures (its ROI, these rows)
-        snr={"rows": rows, "roi": list(a.snr.roi), "frames": a.snr.frames, "exact": a.snr.exact,
+        snr={"rows": rows, "roi": list(a.snr.roi), "frames": a.identity["frames"],
+             "repeats": a.identity.get("repeats", 0), "exact": a.snr.exact,
              "pixels": a.snr.sampled_pixels, "channels": CHANNELS, "verdict": snr_verdict({"scales": rows})},
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
         plot={"bins": a.plot.bins, "frames": a.identity["frames"]},

@@ -42,6 +42,13 @@ class StPlot:
         return int(self.time.shape[0])
 
     @property
+    def decoded(self) -> int:
+        """The video's frames as decoded, repeats included (``meta["frames"]``, what every command
+        quotes as its frames); :attr:`frames` counts the plot's columns, repeats left out."""
+        n = (self.meta or {}).get("frames")
+        return n if isinstance(n, int) and not isinstance(n, bool) and n >= self.frames else self.frames
+
+    @property
     def bins(self) -> int:
         return int(self.horizontal.shape[0])
 
@@ -166,6 +173,11 @@ def compute_stplot(
     if times.n < MIN_FRAMES:
         raise WallcliError(f"{info.source} has {times.n} frame(s); a space-time plot needs at least "
                            f"{MIN_FRAMES} (the temporal mean of one frame is the frame itself)")
+    # a camera pipeline's reader (wallcli.camera.pipeline) leaves repeats out of the columns: "frames"
+    # stays the frames decoded, as snr, scan and the report count them, and what the decode found and
+    # took out goes with the plot, so that an answer read from it lists what the video's lists
+    decoded = getattr(reader, "decoded", None)
+    found = getattr(reader, "corrections", None)
     # the rate the frames' own times run at where they contradict the container's
     fps = float(getattr(reader, "fps", info.fps))
     frac = info.fps if fps == float(info.fps) else Fraction(fps).limit_denominator(1001)
@@ -179,7 +191,7 @@ def compute_stplot(
         "fps_source": getattr(info, "fps_source", "container") if fps == float(info.fps) else "timestamps",
         # the tick the times are exact to, for the rate check of whoever reads the plot (io.rates.plot_rate)
         "time_base": _ratio(getattr(info, "time_base", None)),
-        "frames": times.n,
+        "frames": int(decoded) if isinstance(decoded, int) and decoded >= times.n else times.n,
         "roi": list(roi),
         "bins": int(bins),
         "mean": mean,
@@ -190,6 +202,8 @@ def compute_stplot(
         "wallcli_version": __version__,
         "warnings": list(getattr(reader, "warnings", [])),
     }
+    if callable(found):
+        meta["corrections"] = [dict(c) for c in found()]
     if view is not None:
         meta["view"] = view.record()
     return _finish(h_rows.array(), v_rows.array(), times.array(), meta, mean, mean_seconds,
@@ -245,6 +259,10 @@ def from_arrays(arrays: dict[str, np.ndarray], meta: dict, source: str = "file")
             shift = np.asarray(arrays["shift"], np.float32)
         if shift.shape != (t.size, 2) or not np.all(np.isfinite(shift)):
             raise WallcliError(f"{source} has a malformed 'shift' array (shape {shift.shape}, needs ({t.size}, 2))")
+    found = meta.get("corrections")
+    if found is not None and not (isinstance(found, list) and all(isinstance(c, dict) and isinstance(c.get("kind"), str)
+                                                                   for c in found)):
+        raise WallcliError(f"{source} has a malformed corrections list in its metadata")
     view = meta.get("view")
     if view is not None and not (isinstance(view, dict) and isinstance(view.get("spans"), dict)):
         raise WallcliError(f"{source} has a malformed view record in its metadata")
