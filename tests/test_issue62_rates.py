@@ -55,7 +55,7 @@ def test_every_command_reports_the_video_s_rate_from_the_video_and_from_its_plot
         assert _json(run_cli, "count", source)["window_fps"] == 30.0  # the windows' samples, the model's rate
 
 
-def test_a_plot_of_an_older_wallcli_without_its_time_base_reads_at_240_fps(clip, run_cli, tmp_path):
+def test_a_plot_of_an_older_wallcli_without_its_rate_or_time_base_reads_at_its_rate(clip, run_cli, tmp_path):
     fps, video = clip
     from wallcli.io.arrays import load_npz, save_npz
 
