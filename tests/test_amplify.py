@@ -123,7 +123,7 @@ def test_given_gain_is_linear(shadow_clip, run_cli, tmp_path):
 
 def test_amplifier_warm_up_and_calibration():
     rng = np.random.default_rng(0)
-    amp = Amplifier(calib_frames=10, mean_seconds=5.0)
+    amp = Amplifier(calib_frames=10, mean_seconds=5.0, colour=True)  # per channel: sigma is each channel's
     level = 200.0 + 30.0 * rng.random((6, 8, 3))  # a bright, textured wall: all of it must vanish
     out = []
     for i in range(25):

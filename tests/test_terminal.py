@@ -82,7 +82,8 @@ def test_amplify_names_its_grid_as_its_json_does(clip, tmp_path):
     assert res.returncode == 0, res.stderr
     rows, cols = json.loads(res.stdout)["grid"]
     assert rows != cols and f"{rows} rows x {cols} columns" in res.stderr
-    assert res.stderr.startswith(f"wrote {tmp_path / 'amp.mp4'} (")
+    # the headline figure first (issue 61), then what was written
+    assert res.stderr.startswith("column SNR ") and f"\nwrote {tmp_path / 'amp.mp4'} (" in res.stderr
 
 
 def test_format_db_never_writes_minus_zero():

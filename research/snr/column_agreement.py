@@ -1,7 +1,7 @@
 """How the headline figure (column_snr_db, wallcli/snr/column.py) agrees with the labels' snr_db of the
 rendered recordings: run with the recordings' folder at /work/shared/transfer (edit ROOT)."""
 import csv, json, numpy as np
-ROOT = '/work/shared/transfer'
+ROOT = "/work/shared/transfer"  # the rendered recordings (labels.csv and the clips)
 from wallcli.io.video import open_video
 from wallcli.snr.column import ColumnSnr, CALIBRATION_DB
 rows = list(csv.DictReader(open(ROOT + '/labels.csv')))

@@ -77,6 +77,9 @@ def amplify(
     scale: str = typer.Option("1", "--scale", help="Output panel size: a factor of the ROI size (0.5; rounded to even sizes, at least 2x2) or "
                        "WIDTHxHEIGHT in pixels (even numbers: H.264 4:2:0). The output frame is at most 2x3840x2160 pixels."),
     side_by_side: bool = typer.Option(False, "--side-by-side", help="Original on the left, amplified on the right."),
+    colour: bool = typer.Option(False, "--colour", help="Amplify each colour channel (red, green, blue) instead of "
+                                "showing the luminance change in grey (the default: a shade darkens every colour, "
+                                "and the chroma's own noise paints coloured blobs)."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Output shows the ROI only."),
     crf: int = number_option(18, "--crf", lo=0, hi=51, integer=True, help="H.264 quality (lower = better, bigger)."),
     preset: str = typer.Option("superfast", "--preset", help="x264 speed preset, ultrafast ... veryslow. superfast: 2x faster than veryfast, same size here; ultrafast: 2x faster again, 2x bigger."),
@@ -90,8 +93,16 @@ def amplify(
 
     Each pixel's temporal mean (the static room) is removed, the wall is area-averaged into
     blocks (the noise falls, the broad shadows of people stay), and the rest is shown as
-    128 + gain x signal: grey where nothing changes, coloured where someone blocks or reflects
-    light. One streaming pass; memory does not grow with the video's length.
+    128 + gain x signal in grey (the luminance change; --colour: each channel): mid-grey where
+    nothing changes, darker where someone blocks light, lighter where they reflect it. Beyond
+    the display range the scale bends smoothly (128 + 127 tanh(gain x signal / 127)), so a strong
+    shade keeps its shape instead of being cut flat to white or black. One streaming pass; memory
+    does not grow with the video's length.
+
+    Nothing above the noise: the same frames are measured as `wallcli snr` measures them, and
+    where its verdict finds no wall signal (an empty room, or a person too faint for this video),
+    a warning says that the video shows amplified camera and codec noise. The headline figure,
+    column SNR (column_snr_db, as count, activity and snr give it), is printed first.
 
     Defaults chosen from the clip: on the first --gain-seconds (2 s) of video, the signal and
     noise of the blocks are measured as `wallcli snr` does (noise from frame-to-frame
@@ -127,7 +138,7 @@ def amplify(
     check_output(output, force=force, inputs=[input])
     with committed_together():  # the video and the JSON summary: both or neither
         _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
-                preset, json_out, force, threads)
+                preset, json_out, force, threads, colour=colour)
 
 
 def _warn_small(rw: int, rh: int) -> None:
@@ -141,8 +152,26 @@ def _warn_small(rw: int, rh: int) -> None:
              f"more), and the amplified video shows at most {rw}x{rh} independent blocks: use a larger ROI")
 
 
+def _above_noise(acc, source: str, fps: float):
+    """(snr's verdict, the headline figure) of the frames amplify read; the headline is said first
+    on stderr, and a warning where the verdict finds no wall signal."""
+    from wallcli.cli.output import log, warn
+    from wallcli.snr.column import column_text
+    from wallcli.snr.estimate import MIN_FRAMES, snr_report
+
+    if acc.frames < MIN_FRAMES:
+        return None, None
+    report = snr_report(acc, source=source, fps=fps, roi_mode="given")
+    verdict, db = report["verdict"], report.get("column_snr_db")
+    log(f"{column_text(db)}.")
+    if not verdict["signal"]:
+        warn(f"nothing stands above the noise here ({verdict['text']}, as `wallcli snr` says): the amplified "
+             "video shows the camera's and the codec's noise, not a person's shade")
+    return verdict, db
+
+
 def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds, smooth, scale, side_by_side, crf,
-            preset, json_out, force, threads) -> None:
+            preset, json_out, force, threads, colour: bool = False) -> None:
     import itertools
     from fractions import Fraction
 
@@ -170,6 +199,10 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
             calib = max(2, min(calib, SIDE_BUFFER_BYTES // (pw * ph * 3)))
         depth = 8
         amp = None
+        # is anything above the noise? the same frames, measured as `wallcli snr` measures them
+        from wallcli.snr.estimate import SnrAccumulator
+
+        acc = SnrAccumulator(roi_t, fps=float(info.fps))
         out_w = 2 * pw if side_by_side else pw
         if out_w * ph > MAX_OUTPUT_PIXELS:
             raise UsageError(f"--scale {scale} makes {out_w}x{ph} output frames ({out_w * ph / 1e6:.1f} megapixels); "
@@ -196,7 +229,8 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                                 return quantisation_sigma(rw * rh / (r * k), depth)
 
                             amp = AutoAmplifier(cells=cells, smooth_seconds=smooth, mean=mean, mean_seconds=mean_seconds,
-                                                gain=gain, calib_frames=calib, sigma_floor=floor)
+                                                gain=gain, calib_frames=calib, sigma_floor=floor, colour=colour)
+                        acc.update(planes)
                         # the grids of every block count still in question, from this one decode
                         grids = {c: rgb_grid(planes, roi_t, *grid_shape(rw, rh, c)) for c in amp.wanted}
                         left = original_panel(planes, roi_t, pw, ph) if side_by_side else None
@@ -207,6 +241,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
                     raise WallcliError(f"{input}: only {frames} frame(s); amplify needs at least 2")
                 write(amp.flush() if amp is not None else [])
     _warn_small(rw, rh)  # once the video is written: a run that fails says one line, its error
+    verdict, column_db = _above_noise(acc, input, float(info.fps))
     rows, cols = grid_shape(rw, rh, amp.cells)
     rate = reader.fps  # the frames' own rate where it contradicts the container's
     rate_f = info.fps if rate == float(info.fps) else Fraction(rate).limit_denominator(1001)
@@ -228,6 +263,7 @@ def _render(input, output, roi_t, gain, gain_seconds, cells, mean, mean_seconds,
         "tried": [{"cells": c, "smooth": t, "snr_db": round(v, 2) if np.isfinite(v) else None}
                   for (c, t), v in amp.measured.items()],
         "gain": amp.gain, "gain_mode": "auto" if amp.auto_gain else "fixed", "sigma": amp.sigma,
+        "display": "colour" if colour else "luminance", "column_snr_db": column_db, "verdict": verdict,
     }
     # the grid in the order of the JSON's "grid": [rows, cols]
     wrote((output, f"{frames} frames of {out_w}x{ph} pixels; gain {amp.gain:.4g} "

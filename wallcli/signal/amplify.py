@@ -8,7 +8,12 @@ a few grids whatever the video's length. Per frame:
 1. ``grid``: the ROI's block means, float64 RGB code values (the caller computes it);
 2. subtract a causal running mean (``ema`` by default, or a trailing ``window``);
 3. optionally smooth in time (one-pole low-pass, time constant ``smooth_seconds``);
-4. display = 128 + gain x signal, float32, *unclipped* (the caller upsamples, then clips).
+4. display = 128 + 127 tanh(gain x signal / 127), float32: linear (slope ``gain``) for a
+   person's shade, bent smoothly towards 1 and 255 beyond the range, so nothing is cut flat to
+   white or black, however strong (a hard clip turned strong shades into flat blobs). By default
+   the display is grey, each block's luminance change (Rec. 709 weights): a shade darkens all
+   colours together, and the colour noise of 4:2:0 chroma, three times the luma's, painted the
+   wall in coloured blobs around it; ``colour=True`` shows each channel.
 
 Warm-up. The ``ema`` mean is an expanding average until it has seen about ``mean_seconds`` of
 video (weight max(1/n, 1 - exp(-dt/tau))), then a true EMA. Initialising an EMA from the first
@@ -43,6 +48,7 @@ MEAN_MODES = ("ema", "window")
 GREY = 128.0
 # +-3 robust sigma onto +-127 display levels (same convention as plots.stplot.auto_gain).
 SIGMAS_TO_FULL_SCALE = 3.0
+LUMA = np.array([0.2126, 0.7152, 0.0722], np.float64)  # Rec. 709, as the space-time plot figures
 
 
 def grid_shape(width: int, height: int, cells: int) -> tuple[int, int]:
@@ -115,6 +121,7 @@ class Amplifier:
         gain: float | None = None,
         calib_frames: int = 60,
         sigma_floor: float = 0.0,
+        colour: bool = False,
     ):
         if mean not in MEAN_MODES:
             raise ValueError(f"mean must be one of {MEAN_MODES}, got {mean!r}")
@@ -129,6 +136,7 @@ class Amplifier:
         self.sigma: float | None = None  # the robust sigma the automatic gain came from
         self.calib_frames = max(2, int(calib_frames))
         self.sigma_floor = float(sigma_floor)
+        self.colour = bool(colour)
         self.frames = 0
         self._smooth: np.ndarray | None = None
         self._t_prev = 0.0
@@ -151,13 +159,21 @@ class Amplifier:
         self._t_prev = float(t)
         return s
 
+    def _shown(self, s: np.ndarray) -> np.ndarray:
+        """What the display shows of a signal: each channel, or their luminance in all three."""
+        if self.colour:
+            return s
+        lum = np.asarray(s, np.float64) @ LUMA
+        return np.repeat(lum[..., None], 3, axis=-1)
+
     def _display(self, s: np.ndarray) -> np.ndarray:
-        return (GREY + self.gain * s).astype(np.float32)
+        x = self.gain * self._shown(s)
+        return (GREY + (GREY - 1.0) * np.tanh(x / (GREY - 1.0))).astype(np.float32)
 
     def _calibrate(self) -> None:
         signals = [s for _, s in self._held]
         # The first frame's signal is exactly zero (the mean is that frame): leave it out.
-        sample = np.stack(signals[1:] if len(signals) > 1 else signals)
+        sample = self._shown(np.stack(signals[1:] if len(signals) > 1 else signals))
         sigma = max(robust_sigma(sample), self.sigma_floor, 1e-6)
         self.sigma = float(sigma)
         self.gain = (GREY - 1.0) / (SIGMAS_TO_FULL_SCALE * sigma)
@@ -288,10 +304,11 @@ class AutoAmplifier:
     """
 
     def __init__(self, *, cells: int | None = None, smooth_seconds: float | None = None, mean: str = "ema",
-                 mean_seconds: float = 10.0, gain: float | None = None, calib_frames: int = 60, sigma_floor=None):
+                 mean_seconds: float = 10.0, gain: float | None = None, calib_frames: int = 60, sigma_floor=None,
+                 colour: bool = False):
         self.steps = auto_steps(cells, smooth_seconds)
         self.auto_cells, self.auto_smooth = cells is None, smooth_seconds is None
-        self._kw = dict(mean=mean, mean_seconds=mean_seconds, gain=gain)
+        self._kw = dict(mean=mean, mean_seconds=mean_seconds, gain=gain, colour=colour)
         self.calib_frames = max(3, int(calib_frames))
         self._floor = sigma_floor or (lambda c: 0.0)  # cells -> the gain's sigma floor
         self.measured: dict[tuple[int, float], float] = {}

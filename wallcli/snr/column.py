@@ -6,18 +6,21 @@ generator's definition: the clean column profile's change over time, squared, ov
 one column's mean in one frame), so that the README's bands read the same on a label and on an
 output: under 0 dB a person is under the noise, from 10 dB up plain in the plot.
 
-Measured on the luma of every column of the region, per chunk of CHUNK frames:
-- each column's mean over the chunk is removed, and so is the whole wall's common change in each
-  frame (the mean over the columns: a light's flicker or drift, which an empty room shows too);
-- noise = the columns' power at frequencies above NOISE_HZ, where a person's light is not (the
-  median over columns and frequencies, for the chi-square's median), taken as white;
-- signal = the chunk's whole power less that noise.
+Measured on the luma of every column of the region, per chunk of CHUNK frames, with each
+column's mean over the chunk removed, in spatial components along the wall (a DCT across the
+columns) at each temporal frequency:
+- signal = the power of the broad components (wavelengths over 2 x BROAD_PX pixels: a person's
+  shade, not a codec's 16-pixel blocks) above the noise's level at that frequency, less the whole
+  wall's common change (component 0: a light's flicker or drift, which an empty room shows too);
+- noise = the fine components' power: one column's noise, including what a codec holds for
+  frames (its level at a person's slow frequencies, which the frame-to-frame figure misses).
 The chunks' powers are summed, so a clip's figure weighs every frame alike and memory stays flat.
 
 CALIBRATION_DB: the labels measure the person's change in linear light, before the camera's tone
-curve (which compresses it: about 6.8 dB at a gamma of 2.2), and with the whole-wall dimming a
-person makes; this figure reads the decoded codes. The constant is the median difference on the
-191 rendered recordings with people (8.2 dB); research/snr/README.md gives the agreement.
+curve (which compresses it: about 6.8 dB at a gamma of 2.2), with all of the profile's change
+(the broad components here keep most of it), against a noise from each pixel's own; this figure
+reads the decoded codes. The constant is the median difference on the 191 rendered recordings
+with people (16.1 dB); research/snr/README.md gives the agreement.
 """
 from __future__ import annotations
 
@@ -25,7 +28,8 @@ import numpy as np
 
 CHUNK = 256  # frames (8.5 s at 30 fps, a model window)
 NOISE_HZ = 6.0  # walking, crouching, waving and jumping live under 2.5 Hz
-CALIBRATION_DB = 8.0
+BROAD_PX = 16.0  # a person's shade: components of wavelengths over 2 x 16 px (a codec's block: 16)
+CALIBRATION_DB = 16.0
 FLOOR_DB = -30.0
 _MEDIAN_CHI2_2 = np.log(2.0)  # a periodogram bin's median over its mean, for white noise
 NAME = "column SNR"  # what every terminal calls it
@@ -42,21 +46,30 @@ def _luma(planes, roi) -> np.ndarray:
     return img.mean(axis=0)
 
 
-def chunk_powers(cols: np.ndarray, fps: float) -> tuple[float, float, int]:
+def chunk_powers(cols: np.ndarray, fps: float, px_per_column: float = 1.0) -> tuple[float, float, int]:
     """(signal power, noise power, samples) of a (T, columns) chunk of column means; powers are
-    summed over the chunk's samples (divide by the samples for a mean)."""
-    T = cols.shape[0]
-    if T < 8 or cols.shape[1] < 1:
+    summed over the chunk's samples (divide by the samples for a mean). ``px_per_column``: pixels
+    each column stands for (a plot's bins average several)."""
+    T, W = cols.shape
+    if T < 8 or W < 4:
         return 0.0, 0.0, 0
     g = cols - cols.mean(axis=0, keepdims=True)
-    g = g - g.mean(axis=1, keepdims=True)  # the whole wall's common change
-    f = np.fft.rfftfreq(T, 1.0 / fps)
-    high = f > min(NOISE_HZ, 0.5 * f[-1])
+    z = g @ _dct(W)[1:].T  # the spatial components but the mean (the whole wall's common change)
     taper = np.hanning(T)
-    spec = np.abs(np.fft.rfft(g * taper[:, None], axis=0)) ** 2 / np.sum(taper * taper)
-    noise = float(np.median(spec[high])) / _MEDIAN_CHI2_2 if high.any() else 0.0
-    total = float(np.mean(g * g))
-    return (total - noise) * T, noise * T, T
+    power = np.abs(np.fft.rfft(z * taper[:, None], axis=0)) ** 2 / np.sum(taper * taper)  # (F, W - 1)
+    k = int(min(max(3, round(W * px_per_column / BROAD_PX)), W - 3))
+    # the noise's level at each frequency, read where a broad shade is not (the fine components:
+    # a codec's held noise is slow, and would pass for a person against a fast-noise level)
+    level = np.median(power[:, k:], axis=1) / _MEDIAN_CHI2_2
+    signal = float(np.sum(np.mean(power[:, :k] - level[:, None], axis=0))) / W
+    noise = float(np.mean(power[:, k:]))  # one column's noise power (orthonormal components)
+    return signal * T, noise * T, T
+
+
+def _dct(n: int) -> np.ndarray:
+    k = np.arange(n)[:, None]
+    b = np.cos(np.pi * (np.arange(n)[None] + 0.5) * k / n)
+    return b / np.linalg.norm(b, axis=1, keepdims=True)
 
 
 def to_db(signal: float, noise: float) -> float | None:
@@ -110,11 +123,11 @@ def plot_column_snr_db(plot) -> float | None:
     t = np.asarray(plot.time, np.float64)
     fps = (len(t) - 1) / (t[-1] - t[0]) if len(t) > 1 and t[-1] > t[0] else 30.0
     signal = noise = 0.0
-    for i in range(0, h.shape[0], CHUNK):
-        s, n, _ = chunk_powers(h[i:i + CHUNK], fps)
-        signal, noise = signal + s, noise + n
     roi = (plot.meta or {}).get("roi")
     per_bin = max(float(roi[2]) / h.shape[1], 1.0) if roi else 1.0
+    for i in range(0, h.shape[0], CHUNK):
+        s, n, _ = chunk_powers(h[i:i + CHUNK], fps, per_bin)
+        signal, noise = signal + s, noise + n
     return to_db(signal, noise * per_bin)
 
 
