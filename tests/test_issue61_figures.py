@@ -148,3 +148,18 @@ def test_count_plot_says_what_its_band_is_and_positions_are_fractions(monkeypatc
     labels = ax_p.get_legend_handles_labels()[1]
     assert "one window" not in labels and any("each dot is the answer" in t for t in labels)
     assert ax_h.get_ylim() == (1.0, 0.0) and "0 = view's left" in ax_h.get_ylabel()
+
+
+def test_gallery_titles_follow_counts_rule():
+    # the gallery said "1 people" and "1 people (none)" for a person standing still
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "gallery.py"
+    spec = importlib.util.spec_from_file_location("gallery", path)
+    gallery = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gallery)
+    assert gallery.who({"activities": ["none"]}) == "0 moving (one standing still)"
+    assert gallery.who({"activities": ["walking"]}) == "1 person (walking)"
+    assert gallery.who({"activities": ["walking", "crouching"]}) == "2 people (walking, crouching)"
+    assert gallery.who({"activities": []}) == "0 people (empty room)"
