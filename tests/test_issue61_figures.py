@@ -163,3 +163,9 @@ def test_gallery_titles_follow_counts_rule():
     assert gallery.who({"activities": ["walking"]}) == "1 person (walking)"
     assert gallery.who({"activities": ["walking", "crouching"]}) == "2 people (walking, crouching)"
     assert gallery.who({"activities": []}) == "0 people (empty room)"
+
+
+def test_stplot_help_explains_the_seams_and_units(run_cli):
+    code, out, _ = run_cli("stplot", "--help")
+    said = " ".join(out.split())
+    assert code == 0 and "key frames" in said and "fractions of the view" in said

@@ -13,7 +13,10 @@ from wallcli.cli.common import stream_option, stall_option, PNG_NAME, ROI_HELP, 
 def stplot(
     input: str = input_argument(),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="Write the plots to this .npz (float32 arrays + JSON metadata)."),
-    png: Optional[Path] = typer.Option(None, "--png", help="Draw both plots, amplified, to this PNG. " + PNG_NAME),
+    png: Optional[Path] = typer.Option(None, "--png", help="Draw both plots, amplified, to this PNG, with a colour scale in "
+                                       "code values and positions as fractions of the view (0 = left or top). Vertical seams every "
+                                       "1-2 s in an H.264 file are its key frames (the codec's held noise changes at once), not light. "
+                                       + PNG_NAME),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP),
     bins: int = number_option(64, "--bins", lo=2, hi=4096, integer=True, help="Positions per plot (the networks use 64)."),
     mean: str = typer.Option("clip", "--mean", help="Temporal mean removal: 'clip' (whole recording; files), "
