@@ -169,3 +169,10 @@ def test_stplot_help_explains_the_seams_and_units(run_cli):
     code, out, _ = run_cli("stplot", "--help")
     said = " ".join(out.split())
     assert code == 0 and "key frames" in said and "fractions of the view" in said
+
+
+def test_stplot_says_the_headline_first(run_cli, walker, tmp_path):
+    code, out, err = run_cli("stplot", walker, "-o", tmp_path / "p.npz", "--json")
+    assert code == 0, err
+    said = [line for line in err.splitlines() if line.startswith(("column SNR", "wrote"))]  # warnings aside
+    assert said[0].startswith("column SNR ") and json.loads(out)["column_snr_db"] > 10

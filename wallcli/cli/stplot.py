@@ -75,8 +75,13 @@ def stplot(
         from wallcli.cli.output import warn
 
         warn(narrow)  # compute_plot put it in the .npz's warnings
+    from wallcli.cli.output import log
+    from wallcli.snr.column import column_text, plot_column_snr_db
+
+    column_db = plot_column_snr_db(plot)  # the headline figure, from the plot's bins
     with committed_together():  # the .npz, the PNG and the JSON: all or none
-        _write(plot, input, output, png, style, gain, json_out, force)
+        _write(plot, input, output, png, style, gain, json_out, force, column_db)
+    log(f"{column_text(column_db)}.")  # first, as every command says it
     from wallcli.cli.output import wrote
     from wallcli.wording import frames_text
 
@@ -90,7 +95,7 @@ def check_summary(meta: dict) -> dict | None:
     return ViewCheck.restore(meta["view"]).summary() if isinstance(meta.get("view"), dict) else None
 
 
-def _write(plot, input, output, png, style, gain, json_out, force) -> None:
+def _write(plot, input, output, png, style, gain, json_out, force, column_db=None) -> None:
     from wallcli.cli.output import emit_json
     from wallcli.io.arrays import save_npz
     from wallcli.signal.stplot import channel_std, to_arrays
@@ -104,7 +109,8 @@ def _write(plot, input, output, png, style, gain, json_out, force) -> None:
     if json_out:
         m = plot.meta
         emit_json({
-            "input": input, "output": str(output) if output else None, "png": str(png) if png else None,
+            "input": input, "column_snr_db": column_db,
+            "output": str(output) if output else None, "png": str(png) if png else None,
             "frames": plot.decoded, "corrections": m.get("corrections", []), "duration": float(plot.time[-1] - plot.time[0]), "fps": m["fps"],
             "fps_source": m.get("fps_source", "container"), "roi": m["roi"], "bins": m["bins"], "mean": m["mean"], "frame_size": m["frame_size"],
             "signal_rms": [float(x) for x in channel_std(plot.horizontal)],
