@@ -23,10 +23,11 @@ def _shade(T, W, H, amp):
     return 120.0 - amp * np.exp(-0.5 * ((x - centre) / (0.15 * W)) ** 2)  # (T, W)
 
 
-@pytest.mark.parametrize("amp,sigma", [(0.6, 2.0), (2.0, 2.0), (1.5, 4.0)])
-def test_column_snr_is_the_labels_definition(amp, sigma):
+@pytest.mark.parametrize("amp,sigma,W", [(0.6, 2.0, 64), (2.0, 2.0, 64), (1.5, 4.0, 64), (0.6, 2.0, 1100)])
+def test_column_snr_is_the_labels_definition(amp, sigma, W):
     # the labels' snr_db: the clean column profile's change over the noise of one column's mean
-    T, W, H = 512, 64, 48
+    # (1100 columns: measured in groups of 3, as a wide frame is)
+    T, H = 512, 48
     clean = _shade(T, W, H, amp)
     g = clean - clean.mean(axis=0, keepdims=True)
     g = g - g.mean(axis=1, keepdims=True)

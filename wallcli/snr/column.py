@@ -24,9 +24,12 @@ with people (16.1 dB); research/snr/README.md gives the agreement.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 CHUNK = 256  # frames (8.5 s at 30 fps, a model window)
+MAX_COLUMNS = 512  # wider regions are measured in groups of columns
 NOISE_HZ = 6.0  # walking, crouching, waving and jumping live under 2.5 Hz
 BROAD_PX = 16.0  # a person's shade: components of wavelengths over 2 x 16 px (a codec's block: 16)
 CALIBRATION_DB = 16.0
@@ -36,14 +39,17 @@ NAME = "column SNR"  # what every terminal calls it
 
 
 def _luma(planes, roi) -> np.ndarray:
-    """The region's column means of one frame (float64, one per column)."""
+    """The region's column means of one frame (float64, one per column): exact integer sums."""
     x, y, w, h = roi
+    kind = planes.y.dtype
+    acc = (np.float64 if not np.issubdtype(kind, np.integer) else
+           np.uint64 if h * int(np.iinfo(kind).max) >= 2 ** 32 else np.uint32)
     if getattr(planes, "kind", "yuv") == "rgb":  # y, u, v hold R, G, B
-        img = (planes.y[y:y + h, x:x + w].astype(np.float64) + planes.u[y:y + h, x:x + w]
-               + planes.v[y:y + h, x:x + w]) / 3.0
+        sums = sum(np.sum(p[y:y + h, x:x + w], axis=0, dtype=acc).astype(np.float64)
+                   for p in (planes.y, planes.u, planes.v)) / 3.0
     else:
-        img = planes.y[y:y + h, x:x + w].astype(np.float64)
-    return img.mean(axis=0)
+        sums = np.sum(planes.y[y:y + h, x:x + w], axis=0, dtype=acc).astype(np.float64)
+    return sums / h
 
 
 def chunk_powers(cols: np.ndarray, fps: float, px_per_column: float = 1.0) -> tuple[float, float, int]:
@@ -66,6 +72,7 @@ def chunk_powers(cols: np.ndarray, fps: float, px_per_column: float = 1.0) -> tu
     return signal * T, noise * T, T
 
 
+@functools.lru_cache(maxsize=4)
 def _dct(n: int) -> np.ndarray:
     k = np.arange(n)[:, None]
     b = np.cos(np.pi * (np.arange(n)[None] + 0.5) * k / n)
@@ -106,7 +113,15 @@ class ColumnSnr:
 
     def _flush(self) -> None:
         if self._rows:
-            s, n, t = chunk_powers(np.stack(self._rows), float(self.fps or 30.0))
+            cols = np.stack(self._rows)
+            # a wide frame in groups of columns (a DCT of 3840 columns is 118 MB), each group's
+            # noise scaled back to one column's as for a plot's bins
+            group = -(-cols.shape[1] // MAX_COLUMNS)
+            if group > 1:
+                n = cols.shape[1] // group
+                cols = cols[:, :n * group].reshape(len(cols), n, group).mean(axis=2)
+            s, n, t = chunk_powers(cols, float(self.fps or 30.0), float(group))
+            n *= group
             self.signal, self.noise, self.samples = self.signal + s, self.noise + n, self.samples + t
         self._rows = []
 
