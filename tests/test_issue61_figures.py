@@ -177,3 +177,10 @@ def test_stplot_says_the_headline_first(run_cli, walker, tmp_path):
     assert code == 0, err
     said = [line for line in err.splitlines() if line.startswith(("column SNR", "wrote"))]  # warnings aside
     assert said[0].startswith("column SNR ") and json.loads(out)["column_snr_db"] > 10
+
+
+def test_scan_carries_the_headline_of_count_and_snr(run_cli, walker, tmp_path):
+    code, _, err = run_cli("scan", walker, "-o", tmp_path / "r.jsonl", "--task", "count,snr")
+    assert code == 0, err
+    line = json.loads((tmp_path / "r.jsonl").read_text().splitlines()[0])
+    assert line["count"]["column_snr_db"] == line["snr"]["column_snr_db"] > 10

@@ -64,10 +64,14 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
 
         check = ViewCheck()
         blend = TemporalNoise()
+        from wallcli.snr.column import ColumnSnr
+
+        column = ColumnSnr(fps=float(info.fps))  # the headline figure, as count and activity give it
 
         def each(frame) -> None:
             check(frame)
             blend(frame)
+            column(frame)
             if snr is not None:
                 snr.update(frame.planes)
             if on_frame is not None:
@@ -96,6 +100,7 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
     for task, c in zip(classify, classifiers):
         out[task] = bound_result(with_view(c.result(source, frames=unique.decoded, fps=fps), check),
                                  blend.correction())
+        out[task]["column_snr_db"] = column.db()
     if snr is not None:
         out["snr"] = snr_report(snr, source=source, fps=fps, notes=notes, roi_mode="frame") | {"view": out["view"]}
     for task in TASKS:
