@@ -129,3 +129,40 @@ def test_a_camera_motion_clip_and_its_plot_answer_alike(tmp_path, run_cli):
     video, plot = _json(run_cli, "count", clip), _json(run_cli, "count", tmp_path / "pan.npz")
     assert "camera motion" in video["view"]["issues"] and plot["view"]["issues"] == video["view"]["issues"]
     _same(video, plot)
+
+
+def test_a_clip_labelled_at_another_rate_is_corrected_alike_from_the_video_and_its_plot(tmp_path, run_cli):
+    """Mains flicker folds by the frames' own rate: 120 Hz light at 25 fps is a 5 Hz line. A file
+    that says 30 fps while its frames are 25 a second was searched at 30 fps's lines on the video
+    (10 Hz: a flicker that is not there, and the real one left in) and at 25 fps's on its plot."""
+    from fractions import Fraction
+
+    import av
+
+    from wallcli.cli.app import main
+
+    src = tmp_path / "fl.mkv"
+    with pytest.raises(SystemExit):
+        main(["simulate", "-o", str(src), "--people", "1", "--seed", "4", "--size", "96x72", "--duration", "11",
+              "--fps", "25", "--flicker", "0.02", "--mains", "60"])
+    with av.open(str(src)) as c:
+        frames = [f.to_ndarray(format="rgb24") for f in c.decode(video=0)]
+    clip, tb = tmp_path / "labelled30.mkv", Fraction(1, 1_000_000)
+    with av.open(str(clip), "w") as c:
+        s = c.add_stream("ffv1", rate=30)
+        s.width, s.height, s.pix_fmt = 96, 72, "bgr0"
+        s.codec_context.time_base = tb
+        for i, a in enumerate(frames):
+            f = av.VideoFrame.from_ndarray(a, format="rgb24")
+            f.pts, f.time_base = round(i * Fraction(1, 25) / tb), tb
+            for p in s.encode(f):
+                c.mux(p)
+        for p in s.encode():
+            c.mux(p)
+    code, _, err = run_cli("stplot", clip, "-o", tmp_path / "p.npz")
+    assert code == 0, err
+    video, plot = _json(run_cli, "count", clip), _json(run_cli, "count", tmp_path / "p.npz")
+    assert video["fps"] == plot["fps"] == 25.0
+    flicker = [c for c in video["corrections"] if c["kind"] == "flicker"]
+    assert [round(c["hz"]) for c in flicker] == [5] and flicker[0]["amplitude"] > 0.01
+    _same(video, plot)

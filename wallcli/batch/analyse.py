@@ -81,7 +81,8 @@ def analyse(source: str, tasks, models: dict, *, decoder_threads: int = 0,
         # masked for every analysis of this decode
         unique = CameraPipeline(reader, check)
         tee = _Tee(unique, each)
-        classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections, native_fps=float(info.fps))
+        classifiers = [WindowClassifier(m, int(m.card["stride"]), corrections=corrections,
+                                       native_fps=lambda: reader.fps)
                        for m in used]
         if classifiers:
             vertical = any("vertical" in m.input_names for m in used) or corrections.light

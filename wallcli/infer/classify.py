@@ -20,7 +20,7 @@ from wallcli.camera import corrections as corr
 from wallcli.errors import WallcliError
 from wallcli.infer.judge import judge_view, with_view
 from wallcli.infer.result import clip_result, window_record
-from wallcli.infer.windows import WindowStream, plot_fps, plot_windows, stream_row
+from wallcli.infer.windows import WindowStream, plot_fps, plot_windows, stream_row, video_fps
 
 
 def classify_plot(model, plot, *, stride: int, source: str, corrections: corr.Options = corr.Options()) -> dict[str, Any]:
@@ -63,7 +63,7 @@ class WindowClassifier(WindowStream):
         (quoting ``frames``, the video's decoded frames, where given). ``fps``: the video's rate as
         read (VideoReader.fps); default the container's (``native_fps``)."""
         return clip_result(self.model, *self.windows(str(source), frames), stride=self.stride, source=str(source),
-                           fps=fps or self.native_fps)
+                           fps=fps or self.native())
 
 
 def _too_short_video(source: str, check, model, frames: int | None = None) -> WallcliError:
@@ -129,7 +129,8 @@ class _Decode:
         camera blended its noise, signal_db is an upper bound."""
         from wallcli.camera.tnr import bound_result
 
-        result = with_view(classifier.result(source, frames=self.unique.decoded, fps=self.reader.fps), self.check)
+        result = with_view(classifier.result(source, frames=self.unique.decoded, fps=video_fps(self.reader)),
+                           self.check)
         result["corrections"] += self.unique.corrections()
         return bound_result(result, self.blend.correction())
 
@@ -155,7 +156,7 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
     column = ColumnSnr(roi)  # the headline figure, from the same decode
     taps = (*taps, column)
     with open_video(source, threads=threads) as reader:
-        classifier.native_fps = float(reader.info.fps)
+        classifier.native_fps = lambda: video_fps(reader)  # the frames' own rate, as stplot records it
         for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
@@ -212,7 +213,7 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     # the classifier of classify_video, so that the lines are its windows (and its clip answer)
     classifier = WindowClassifier(model, stride, corrections=corrections)
     with open_video(source, threads=threads) as reader:
-        classifier.native_fps = float(reader.info.fps)
+        classifier.native_fps = lambda: video_fps(reader)  # the frames' own rate, as stplot records it
         # cleaned as in classify_video (a line lists no corrections of the clip's)
         decode = _Decode(model, reader, roi=roi, corrections=corrections)
         rows = decode.rows

@@ -35,6 +35,13 @@ def plot_fps(plot, source: str) -> float | None:
     return None if rate is None else float(rate)
 
 
+def video_fps(reader) -> float:
+    """A video's rate as the frames read so far say it (VideoReader.fps: the timestamps' where they
+    contradict the container's), else its container's: what stplot records, and so the one rule of a
+    video's answers and its plot's."""
+    return float(getattr(reader, "fps", None) or reader.info.fps)
+
+
 def resampled_plots(model, plot, both: bool = False) -> tuple[dict[str, np.ndarray], np.ndarray]:
     """The plot's inputs for ``model`` at its canonical rate: ({name: (bins, T', 3)}, time (T',));
     ``both``: both plots, whatever the model reads (for the corrections)."""
@@ -129,7 +136,10 @@ class WindowStream:
 
     def __init__(self, model, stride: int, *, corrections: corr.Options = corr.Options(), native_fps=None):
         self.model, self.stride = model, int(stride)
-        self.corrections, self.native_fps = corrections, native_fps  # native_fps: the video's own rate
+        # native_fps: the video's own rate, or a callable giving it as the frames read so far say
+        # (VideoReader.fps: the timestamps' where they contradict the container's), which is what
+        # stplot records and a plot's windows are corrected at: the mains lines are the same on both
+        self.corrections, self.native_fps = corrections, native_fps
         self.windower = StreamWindower(model.window, stride, model.fps)
         self.times, self.probs, self.signal, self.found = [], [], [], []
         self.ref = None
@@ -138,12 +148,17 @@ class WindowStream:
         self.ref = ref
         done = self.windower.push(t, row)
         if done is not None:
-            p, db, f = predict_window(self.model, done[2], ref, start=done[0], native=self.native_fps,
+            p, db, f = predict_window(self.model, done[2], ref, start=done[0], native=self.native(),
                                       options=self.corrections)
             self.times.append(done[0])
             self.probs.append(p)
             self.signal.append(db)
             self.found.append(f)
+
+    def native(self) -> float | None:
+        """The video's own rate now (see ``native_fps``)."""
+        n = self.native_fps() if callable(self.native_fps) else self.native_fps
+        return float(n) if n else None
 
     @property
     def empty(self) -> bool:
@@ -158,10 +173,10 @@ class WindowStream:
         last = w.pending()
         if self.empty:
             raise too_short(source, w.count if frames is None else frames, model,
-                            None if frames is None else self.native_fps)
+                            None if frames is None else self.native())
         times, probs, signal, found = list(self.times), list(self.probs), list(self.signal), list(self.found)
         if last is not None:  # window_starts' end-aligned window: the last `window` rows
-            p, db, f = predict_window(model, last[2], self.ref, start=last[0], native=self.native_fps,
+            p, db, f = predict_window(model, last[2], self.ref, start=last[0], native=self.native(),
                                       options=self.corrections)
             times.append(last[0])
             probs.append(p)

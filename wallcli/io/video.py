@@ -198,7 +198,10 @@ class VideoReader:
         otherwise by more than RATE_TOLERANCE (a stream labelled 30 fps whose frames are 0.1 s
         apart, a 30 fps GIF whose 3-3-4 centisecond delays are read as 33.3 fps)."""
         got, said = self.measured_fps, float(self.info.fps)
-        return got if got is not None and abs(got - said) > RATE_TOLERANCE * said else said
+        if got is None or abs(got - said) <= RATE_TOLERANCE * said:
+            return said
+        # as a rate is stated (stplot's fps_fraction): 25, not the 24.999999999999996 a sum of intervals gives
+        return float(Fraction(got).limit_denominator(1001))
 
     def _pick_stream(self, source: str, index: int | None):
         """The video stream to read: ``index`` (--stream N) or the first real one; a file with

@@ -210,7 +210,8 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
         warnings.simplefilter("always")
         info = reader.info
         tee = _Tee(reader, roi, corrections)
-        classifiers = {t: WindowClassifier(m, int(m.card["stride"]), corrections=options, native_fps=float(info.fps))
+        classifiers = {t: WindowClassifier(m, int(m.card["stride"]), corrections=options,
+                                          native_fps=lambda: reader.fps)
                        for t, m in models.items() if t in TASKS}
         first = models["count"]
         rows = RowStream(tee, roi=roi, bins=first.bins, fps=first.fps, progress=progress, vertical=True,
