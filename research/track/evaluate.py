@@ -83,7 +83,8 @@ def main() -> None:
             sel = [r for r in rows if r["people"] == p and r["band"] == b]
             if sel:
                 s2 = [r["simultaneous"]["seconds"] for r in sel]
-                print(f"people={p} band={b:5s} n={len(sel):3d} two tracks at once >= 2 s: {sum(s >= 2 for s in s2)}; "
+                print(f"people={p} band={b:5s} n={len(sel):3d} two tracks at once > 0 s: {sum(s > 0 for s in s2)}, "
+                      f">= 2 s: {sum(s >= 2 for s in s2)}; "
                       f"median {np.median(s2):.1f} s; tracks median {np.median([r['tracks'] for r in sel]):.0f}")
     if a.json:
         a.json.write_text(json.dumps(rows, indent=1))
