@@ -30,7 +30,6 @@ import numpy as np
 
 CHUNK = 256  # frames (8.5 s at 30 fps, a model window)
 MAX_COLUMNS = 512  # wider regions are measured in groups of columns
-NOISE_HZ = 6.0  # walking, crouching, waving and jumping live under 2.5 Hz
 BROAD_PX = 16.0  # a person's shade: components of wavelengths over 2 x 16 px (a codec's block: 16)
 CALIBRATION_DB = 16.0
 FLOOR_DB = -30.0
@@ -126,7 +125,7 @@ class ColumnSnr:
         self._rows = []
 
     def db(self) -> float | None:
-        # a short tail joins the figure only if it can hold frequencies above NOISE_HZ
+        # a short tail joins the figure if it holds 8 frames or more (chunk_powers)
         self._flush()
         return to_db(self.signal, self.noise)
 
