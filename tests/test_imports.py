@@ -113,3 +113,70 @@ def test_only_the_cli_knows_the_cli():
     edges = _imports()
     assert sorted(f"{m} -> {t}" for m, targets in edges.items() for t in targets
                   if _folder(t) == "cli" and _folder(m) not in {"cli", "__main__"}) == []
+
+
+# Start-up (issue 60 point 3): a command imports only what it uses. The heavy optional packages
+# never load on the analysis commands' path, the models' runtime stays off the commands that run
+# no net, and each net's session is built once.
+_PROBE = r"""
+import contextlib, importlib.abc, importlib.util, io, json, sys
+built = []
+
+
+class _Watch(importlib.abc.MetaPathFinder):
+    # counts the sessions built, without importing onnxruntime before the command does
+    def find_spec(self, name, path, target=None):
+        if name != "onnxruntime":
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.util.find_spec(name)
+        run = spec.loader.exec_module
+
+        def exec_module(module):
+            run(module)
+            init = module.InferenceSession.__init__
+
+            def counted(self, *a, **k):
+                built.append(1)
+                init(self, *a, **k)
+            module.InferenceSession.__init__ = counted
+        spec.loader.exec_module = exec_module
+        return spec
+
+
+sys.meta_path.insert(0, _Watch())
+from wallcli.cli.app import main
+with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+    try:
+        main(sys.argv[1:])
+    except SystemExit as exc:
+        assert not exc.code, exc.code
+print(json.dumps({"modules": sorted({m.split(".")[0] for m in sys.modules}), "sessions": len(built)}))
+"""
+HEAVY = {"matplotlib", "dask", "distributed", "jinja2", "torch", "pandas", "scipy", "sklearn"}
+EXAMPLE = PACKAGE.parent / "examples" / "walking.mp4"
+
+
+def _loaded(*args: str) -> dict:
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", _PROBE, *args], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_the_analysis_commands_import_only_what_they_use(tmp_path):
+    for cmd, nets in (("count", 2), ("activity", 2), ("track", 0), ("stplot", 0)):
+        args = [cmd, str(EXAMPLE)] + (["-o", str(tmp_path / "p.npz"), "--force"] if cmd == "stplot" else ["--json"])
+        got = _loaded(*args)
+        assert HEAVY & set(got["modules"]) == set(), cmd
+        assert ("onnxruntime" in got["modules"]) == bool(nets), cmd
+        assert got["sessions"] == nets, cmd  # count's two-stage rule: the count net and the activity net, once each
+
+
+def test_the_import_probe_sees_a_heavy_import(tmp_path):
+    # the probe must be able to fail: a plot's PNG is drawn with matplotlib, and the probe sees it
+    got = _loaded("stplot", str(EXAMPLE), "-o", str(tmp_path / "p.npz"), "--png", str(tmp_path / "p.png"), "--force")
+    assert "matplotlib" in got["modules"]
