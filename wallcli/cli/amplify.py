@@ -61,7 +61,8 @@ def amplify(
     input: str = input_argument(),
     output: Path = typer.Argument(..., help="Output video (.mp4, .mov, .m4v or .mkv; H.264).", show_default=False),
     gain: Optional[float] = number_option(None, "--gain", lo=0, hi=1e8, lo_open=True, help="Display levels per code value of signal "
-                                         "(output = 128 + gain x signal). Default: automatic, +-3 robust sigma of "
+                                         "(output = 128 + gain x signal, bent smoothly towards 1 and 255 beyond the range: "
+                                         "128 + 127 tanh(gain x signal / 127)). Default: automatic, +-3 robust sigma of "
                                          "the first --gain-seconds (after the automatic --cells and --smooth) fill the range, then fixed."),
     gain_seconds: float = number_option(2.0, "--gain-seconds", lo=0.05, hi=600, help="Video at the start used to measure the automatic "
                                        "gain, --cells and --smooth (those frames are held back as small grids and written once they are known)."),
@@ -111,7 +112,8 @@ def amplify(
     12 dB is used, else the one with the highest SNR; then the gain maps +-3 robust sigma of
     that signal onto the display range. A --cells, --smooth or --gain given is used as given
     (the others are still chosen). The choice is printed with --json (cells, smooth, and
-    display_snr_db: the display's own SNR, neither count's signal nor snr's pixel SNR).
+    display_snr_db: the display's own SNR, neither the headline column SNR, count's signal_db nor snr's
+    pixel SNR).
     The video is still decoded once: those first seconds are held back as small block grids only.
 
     \b
