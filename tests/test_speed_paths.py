@@ -25,3 +25,34 @@ def test_column_sums_are_exact(dtype, top, kind):
         np.testing.assert_allclose(got, want, rtol=1e-6)
     else:
         assert np.array_equal(got, want)  # integer codes: the same sums to the last bit
+
+
+def _svd_reference(x: np.ndarray) -> tuple[np.ndarray, list[float], list[float]]:
+    """The features' former SVD path: energy shares, and each plot's top pattern's spectral peak."""
+    s = np.linalg.svd(x, compute_uv=False)
+    e = s ** 2 / np.maximum((s ** 2).sum(1, keepdims=True), 1e-30)
+    fr, pk = [], []
+    for w in x:
+        sp = np.abs(np.fft.rfft(np.linalg.svd(w, full_matrices=False)[2][0])) ** 2
+        sp[0] = 0
+        fr.append(int(sp.argmax()))
+        pk.append(sp.max() / max(sp.sum(), 1e-30))
+    return e, fr, pk
+
+
+def test_window_features_gram_path_matches_the_svd():
+    from wallcli.signal import features
+
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal((4, 64, 256))
+    x[1] = 0.0  # a still, noise-free window: the SVD's own choice is kept
+    x[2] = np.outer(rng.standard_normal(64), np.sin(np.arange(256) / 4.0)) + 0.01 * rng.standard_normal((64, 256))
+    x[3] = np.outer(np.linspace(1, 2, 64), np.cos(np.arange(256) / 9.0))  # rank one: a lone pattern
+    e, fr, pk = _svd_reference(x)
+    np.testing.assert_allclose(features._energies(x), e, atol=1e-12)
+    got = features._top_patterns(x)
+    for i, w in enumerate(got):
+        sp = np.abs(np.fft.rfft(w)) ** 2
+        sp[0] = 0
+        assert int(sp.argmax()) == fr[i]
+        assert abs(sp.max() / max(sp.sum(), 1e-30) - pk[i]) < 1e-9
