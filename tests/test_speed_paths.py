@@ -56,3 +56,13 @@ def test_window_features_gram_path_matches_the_svd():
         sp[0] = 0
         assert int(sp.argmax()) == fr[i]
         assert abs(sp.max() / max(sp.sum(), 1e-30) - pk[i]) < 1e-9
+
+
+def test_overlay_integer_thresholds_compare_as_the_float_ones():
+    from wallcli.camera.overlay import _code
+
+    d = np.arange(256, dtype=np.uint8).reshape(16, 16)
+    for t in (0.5, 1.0, 3.7, 12.0, 12.5, 254.9, 255.0, 300.0):
+        assert np.array_equal(d > _code(d, t), d > t) and np.array_equal(d <= _code(d, t), d <= t), t
+    f = d.astype(np.float32)
+    assert _code(f, 3.7) == 3.7  # float differences keep the float threshold

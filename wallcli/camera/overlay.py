@@ -148,8 +148,8 @@ class OverlayFilter:
         self._sig.append(max(1.4826 * median, p90 / 1.645))
         sigma = float(np.median(self._sig))
         self._contrast = max(K_STEP * sigma, ABS_STEP)
-        big = d > self._contrast
-        still = d <= max(REL_FROZEN * sigma, 0.5)
+        big = d > _code(d, self._contrast)
+        still = d <= _code(d, max(REL_FROZEN * sigma, 0.5))
         self._still.append((self._index, still))
         # how much each sample changes, frame to frame, over the last STILL_RUN seconds (a running
         # mean): a codec touches a still text by a code now and then, the wall's noise always
@@ -409,6 +409,15 @@ def merged(items) -> list[dict]:
         else:
             groups.append([box, first, start])
     return [{"box": [int(v) for v in b], "kind": "overlay", "from": f, "masked_from": m} for b, f, m in groups]
+
+
+def _code(d: np.ndarray, threshold: float):
+    """``threshold`` for ``d > t`` and ``d <= t`` on integer differences ``d`` (not >= or <): its floor
+    as the array's own type, so the comparison stays in 8 bits (against a float numpy widens every
+    sample first: 0.04 ms a comparison of a 640x360 lattice, ten times the integer one)."""
+    if d.dtype != np.uint8 or threshold < 0:
+        return threshold
+    return np.uint8(min(int(np.floor(threshold)), 255))
 
 
 def _median_p90(a: np.ndarray) -> tuple[float, float]:
