@@ -1,6 +1,8 @@
 """Small `wallcli scan` results (docs/contract.md: one JSON object per video and line), written by hand:
 answers decided and undetermined, results from before the confident flag, a failed video, a
-hostile file name and a last line cut short by a killed scan."""
+hostile file name and a last line cut short by a killed scan. The headline column SNR sits in the
+first line's snr object, in the second's count and activity objects only, and not in the third
+(results from before it existed)."""
 from __future__ import annotations
 
 import json
@@ -30,12 +32,12 @@ RECORDS = [
      "count": _answer("count", 1, [0.02, 0.93, 0.05], confident=True, reason=None, signal_db=12.46),
      "activity": _answer("activity", "walking", [0.05, 0.9, 0.03, 0.01, 0.01], confident=True, reason=None,
                          signal_db=-0.04),
-     "snr": _snr([0.5, 0.4, 0.6], [0.2, 0.2, 0.3]), "error": None},
+     "snr": dict(_snr([0.5, 0.4, 0.6], [0.2, 0.2, 0.3]), column_snr_db=19.12), "error": None},
     {"input": f"cam1/{HOSTILE}.mp4", "size": 2_000_000, "sha256": "b" * 64, "duration": 30.5, "frames": 915,
      "count": _answer("count", 2, [0.1, 0.3, 0.6], confident=False, reason="signal 3 dB under the model's validated range",
-                      signal_db=-30.0),
+                      signal_db=-30.0, column_snr_db=-4.75),
      "activity": _answer("activity", "none", [0.9, 0.04, 0.03, 0.02, 0.01], confident=True, reason=None,
-                         signal_db=-28.5),
+                         signal_db=-28.5, column_snr_db=-4.75),
      "snr": _snr([0.01, 0.01, 0.01], [1.0, 1.0, 1.0]), "error": None},
     {"input": "cam2/old.mp4", "size": 500_000, "sha256": "c" * 64, "duration": 9.0, "frames": 270,
      "count": _answer("count", 0, [0.8, 0.15, 0.05]),  # written before the confident flag existed

@@ -79,8 +79,8 @@ def test_scan_page_in_a_browser_sorts_and_filters(tmp_path, run_cli):
     root = _check_loaded(dom, console)
     got = json.loads(root.attrs["data-actions"])
     hostile = f"cam1/{HOSTILE}.mp4"
-    # pixel SNR G: -99, -20, 3.0 dB; videos without one stay last in both directions
-    assert got["snrUp"] == ["cam2/old.mp4", hostile, "cam1/0001.mp4", "cam2/broken.mp4", "(line 5)"]
+    # column SNR: 19.1, -4.8 dB, none for the old results; videos without one stay last both ways
+    assert got["snrUp"] == [hostile, "cam1/0001.mp4", "cam2/old.mp4", "cam2/broken.mp4", "(line 5)"]
     assert got["snrDown"] == ["cam1/0001.mp4", hostile, "cam2/old.mp4", "cam2/broken.mp4", "(line 5)"]
     assert got["durationUp"] == ["cam2/old.mp4", "cam1/0001.mp4", hostile, "cam2/broken.mp4", "(line 5)"]
     assert got["sorted"] == "ascending null"

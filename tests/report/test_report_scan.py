@@ -24,8 +24,10 @@ def index(tmp_path, run_cli):
 def test_one_row_per_video_with_its_answers(index):
     rows = [[cell.replace("/ ", "/") for cell in r] for r in table_rows(parse(index).by_id("results"))]
     assert [r[0] for r in rows] == ["cam1/0001.mp4", f"cam1/{HOSTILE}.mp4", "cam2/old.mp4", "cam2/broken.mp4", "(line 5)"]
-    name, duration, snr, count, count_db, activity, activity_db, error = zip(*rows)
+    name, duration, column, count, count_db, activity, activity_db, snr, error = zip(*rows)
     assert duration == ("12.00", "30.50", "9.00", "", "")
+    # the headline column SNR first: the snr object's, else count's/activity's; blank when absent
+    assert column == ("19.1", "-4.8", "", "", "")
     # figures as the results hold them: snr.snr_db of green, each task's signal_db; never "-0.0"
     assert snr == tuple(f"{r['snr']['snr_db'][1]:.1f}" for r in RECORDS[:3]) + ("", "") == ("3.0", "-20.0", "-99.0", "", "")
     assert count_db == ("12.5", "-30.0", "", "", "") and activity_db == ("0.0", "-28.5", "", "", "")
@@ -46,7 +48,7 @@ def test_names_break_at_slashes_and_reasons_fold(index):
     assert len(folded) == 1 and folded[0].find_all("summary")[0].text() == "undetermined, most likely 2 people"
     assert "validated range" in folded[0].text()
     assert not cells[0][3].find_all("details")  # a decided answer is short: nothing to fold
-    error = cells[3][7].find_all("details")
+    error = cells[3][8].find_all("details")
     assert len(error) == 1 and error[0].text().startswith(error[0].find_all("summary")[0].text()[:40])
 
 
@@ -54,8 +56,19 @@ def test_sort_keys_are_numbers_and_blanks(index):
     body = parse(index).by_id("results").find_all("tbody")[0]
     keys = [[td.attrs.get("data-sort") for td in tr.find_all("td")] for tr in body.find_all("tr")]
     assert [k[1] for k in keys] == ["12.0", "30.5", "9.0", "", ""]
-    assert float(keys[0][2]) == pytest.approx(10 * math.log10(0.4 / 0.2))
+    assert [k[2] for k in keys] == ["19.12", "-4.75", "", "", ""]
+    assert float(keys[0][7]) == pytest.approx(10 * math.log10(0.4 / 0.2))
     assert [k[4] for k in keys] == ["12.46", "-30.0", "", "", ""]
+
+
+def test_the_column_snr_is_the_first_figure_and_each_figure_is_named(index):
+    """Issue 61.1: the headline figure first under its one name; pixel SNR a later, named column."""
+    heads = [th.text() for th in parse(index).by_id("results").find_all("th")]
+    assert heads[2] == "column SNR (dB)"
+    assert heads.index("pixel SNR G (dB)") > heads.index("activity")
+    assert [h for h in heads if "SNR" in h] == ["column SNR (dB)", "pixel SNR G (dB)"]
+    note = " ".join(parse(index).by_id("videos").text().split())
+    assert "Column SNR is the results' column_snr_db" in note
 
 
 def test_totals_on_top(index):

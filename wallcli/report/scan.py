@@ -107,6 +107,16 @@ def snr_figure(snr: Any) -> float | None:
     return _num(db[g]) if g < len(db) else None
 
 
+def column_figure(rec: dict[str, Any]) -> float | None:
+    """The headline column SNR (``column_snr_db``, wallcli/snr/column.py) of a results line: its
+    snr object's, else count's, else activity's (one decode measures it once; scan copies it)."""
+    for task in ("snr", *TASKS):
+        obj = rec.get(task)
+        if isinstance(obj, dict) and _num(obj.get("column_snr_db")) is not None:
+            return _num(obj["column_snr_db"])
+    return None
+
+
 def _signal(obj: Any) -> float | None:
     """A task's signal_db: the analysed windows' signal over the plot's noise, its answer judged on it."""
     return _num(obj.get("signal_db")) if isinstance(obj, dict) else None
@@ -124,6 +134,7 @@ def _row(rec: dict[str, Any]) -> dict[str, Any]:
         "duration": _num(rec.get("duration")), "frames": _num(rec.get("frames")),
         "size": size if isinstance(size, int) and not isinstance(size, bool) else None,
         "sha256": rec.get("sha256") if isinstance(rec.get("sha256"), str) else None,
+        "column_snr_db": column_figure(rec),
         "snr_db": snr_figure(rec.get("snr")),
         "signal_db": {t: _signal(rec.get(t)) for t in TASKS},
         "count": tasks["count"], "activity": tasks["activity"],
