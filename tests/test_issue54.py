@@ -239,7 +239,7 @@ def test_the_report_leads_its_snr_section_with_snrs_verdict(tmp_path, run_cli):
     assert code == 0, err
     page = (tmp_path / "r.html").read_text(encoding="utf-8")
     said = re.search(r'<p class="verdict" id="snr-verdict">(.*?)</p>', page, re.S)
-    assert said and f"Verdict: {verdict['text']}." in html.unescape(said.group(1))
+    assert said and f"Block SNR verdict: {verdict['text']}." in html.unescape(said.group(1))
 
 
 def test_activitys_reason_is_the_one_that_decided(run_cli):

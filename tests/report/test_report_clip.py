@@ -112,8 +112,34 @@ def test_verdicts_are_what_the_commands_answer(clip_report, hostile_clip, run_cl
     assert [float(w[0]) for w in windows] == pytest.approx([w["start"] for w in ref["windows"]], abs=0.006)
     # the figure each answer was judged on, as the JSON and the terminal write it
     assert [w[3] for w in windows] == [f"{w['signal_db']:.1f}".replace("-0.0", "0.0") for w in ref["windows"]]
-    assert f"signal {ref['signal_db']:.1f} dB".replace("-0.0", "0.0") in verdict
+    assert f"signal_db {ref['signal_db']:.1f} dB".replace("-0.0", "0.0") in verdict
     assert len(section.find_all("img")) == 1
+
+
+def test_the_column_snr_is_said_first_by_its_name(clip_report, hostile_clip, run_cli):
+    """Issue 61.1: the headline figure every command prints first leads the page's verdicts and
+    names the Signal and noise section, as snr --json gives it; the other figures are named apart."""
+    from wallcli.snr.column import column_text
+    from wallcli.wording import format_db
+
+    code, out, err = run_cli("snr", hostile_clip, "--json")
+    assert code == 0, err
+    db = json.loads(out)["column_snr_db"]
+    assert isinstance(db, float)
+    page = parse(clip_report.read_text(encoding="utf-8"))
+    head = page.by_id("verdicts").find_all("p")
+    assert head[0].attrs.get("id") == "column-snr" and head[0].text() == column_text(db)
+    assert head[0].text().startswith(f"column SNR {format_db(db)} dB")
+    snr = page.by_id("snr")
+    assert snr.find_all("h2")[0].text() == f"Signal and noise: column SNR {format_db(db)} dB"
+    paras = snr.find_all("p")
+    assert paras[0].attrs.get("id") == "column-snr-line" and "column_snr_db" in paras[0].text()
+    assert paras[1].attrs.get("id") == "snr-verdict" and paras[1].text().startswith("Block SNR verdict: ")
+    heads = [th.text() for th in page.by_id("snr-table").find_all("th")]
+    assert "block SNR G (dB)" in heads and "SNR G (dB)" not in heads
+    for task in ("count", "activity"):
+        windows = page.by_id(task).find_all("table", class_="windows")[0]
+        assert "signal_db (dB)" in [th.text() for th in windows.find_all("th")]
 
 
 def test_models_come_from_their_cards(clip_report):
@@ -159,7 +185,7 @@ def test_the_headline_says_each_undetermined_answer_in_plain_words():
     assert head.endswith("the video is not a still view of a wall (camera motion)")
     head = finding("activity", {"label": "walking", "probabilities": [0, 0.97, 0.03, 0, 0], "confident": True,
                                 "reason": None, "signal_db": 12.34})
-    assert head == "Activity: walking (decided; probability 0.97, signal 12.3 dB)"
+    assert head == "Activity: walking (decided; probability 0.97, signal_db 12.3 dB)"
 
 
 def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monkeypatch):
@@ -196,7 +222,8 @@ def test_undetermined_answers_and_a_transfer_block(hostile_clip, tmp_path, monke
     assert count.find_all("p", class_="verdict")[0].text().startswith(f"Clip: undetermined ({reason})")
     assert all(w[2] == f"undetermined ({reason})" for w in table_rows(count.find_all("table", class_="windows")[0]))
     # the headline is a finding: the answer most likely, then why (a reason it has no words for, as it is)
-    assert page.by_id("verdicts").text().startswith(f"Count: undetermined, most likely 1 person (probability")
+    findings = page.by_id("verdicts").find_all("p")  # the column SNR first, then one per task
+    assert findings[1].text().startswith(f"Count: undetermined, most likely 1 person (probability")
     assert reason in page.by_id("verdicts").text()
     activity = page.by_id("activity")
     assert "decided (within the model's validated range)" in activity.text()

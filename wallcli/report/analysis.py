@@ -46,6 +46,7 @@ class ClipAnalysis:
     options: Any = None  # the corrections asked for (wallcli.camera.corrections.Options)
     snr_corrections: list = field(default_factory=list)  # what the SNR estimator's corrections found
     tracks: dict[str, Any] | None = None  # wallcli track's result on the same rows
+    column_snr_db: float | None = None  # the headline figure (wallcli.snr.column), as snr --json gives it
 
 
 class _Tee:
@@ -264,7 +265,9 @@ def analyse(source: str, *, roi=None, models: dict[str, Any], threads: int = 0,
     out = ClipAnalysis(str(source), identity, tuple(rows.roi), plot, snr, tee.grid, tee.first, models,
                        warnings=notes, view=tee.view.summary(),
                        options=corrections if corrections is not None else Options(),
-                       snr_corrections=list(tee.snr.corrections))
+                       snr_corrections=list(tee.snr.corrections),
+                       # the accumulator's own column tap: the same frames, the figure snr --json gives
+                       column_snr_db=tee.snr.column.db() if getattr(tee.snr, "column", None) is not None else None)
     from wallcli.infer.track import MIN_SAMPLES, track_result
 
     if tracker.samples >= MIN_SAMPLES:

@@ -84,8 +84,16 @@ def clip_page(a, *, command: str) -> str:
         grid={"rows": a.grid.rows, "cols": a.grid.cols, "cw": a.grid.cw, "ch": a.grid.ch},
         plot={"bins": a.plot.bins, "frames": a.identity["frames"]},
         figures=figures, tasks=tasks, models=[model_summary(a.models[t]) for t in ("count", "activity")],
-        corrections=corrections_view(a), view=a.view, tracks=a.tracks,
+        corrections=corrections_view(a), view=a.view, tracks=a.tracks, column=_column_view(a),
     )
+
+
+def _column_view(a) -> dict[str, Any]:
+    """The headline figure as every command prints it first (wallcli.snr.column.column_text)."""
+    from wallcli.snr.column import NAME, column_text
+
+    db = getattr(a, "column_snr_db", None)
+    return {"name": NAME, "db": db, "text": column_text(db)}
 
 
 def scan_page(source: str, summary: dict[str, Any], problems: list[str], *, command: str) -> str:

@@ -79,7 +79,7 @@ def plain_why(reason: str | None, obj: dict[str, Any]) -> str:
 
 def finding(task: str, obj: Any) -> str:
     """The page's headline for one task, in plain words: 'Count: 1 person (decided; probability
-    0.97, signal 12.3 dB)' or 'Count: undetermined, most likely 1 person; <why>'."""
+    0.97, signal_db 12.3 dB)' or 'Count: undetermined, most likely 1 person; <why>'."""
     from wallcli.wording import format_db
 
     name = task.capitalize()
@@ -87,7 +87,8 @@ def finding(task: str, obj: Any) -> str:
         return f"{name}: no answer"
     a = answer(task, obj)
     signal = obj.get("signal_db")
-    at = f", signal {format_db(signal)} dB" if isinstance(signal, (int, float)) else ""
+    # named as count's table heads it: not the headline column SNR, which the page says first
+    at = f", signal_db {format_db(signal)} dB" if isinstance(signal, (int, float)) else ""
     p = f"probability {a['p']:.2f}" if a["p"] is not None else "probability unknown"
     if a["confident"] is False:
         return f"{name}: undetermined, most likely {a['label']} ({p}); {plain_why(a['reason'], obj)}"
