@@ -281,26 +281,28 @@ def test_the_two_people_check_alone_is_the_reason_where_the_card_would_decide():
         (False, "card's reason; two people likely too (p=0.60 of two among people moving)")
 
 
-def test_evaluates_measured_bands_are_on_the_answers_signal(tmp_path, capsys):
-    """walking.mp4's answer says "signal -3.4 dB ... under 0 dB" while evaluate put it in "0-10 dB"
-    by the block SNR (6.8 dB): without an snr_db column the bands are on the answer's signal_db."""
+def test_evaluates_measured_bands_are_on_the_column_snr(tmp_path, capsys):
+    """walking.mp4: block SNR 6.8 dB, the answer's signal_db -3.4 dB and the headline column SNR
+    19.1 dB. Without an snr_db column the bands are on the column SNR (issue 61.1: the figure every
+    command prints first, on the labels' scale), neither of the other two."""
     from wallcli.cli._evaluate_table import print_evaluation
     from wallcli.evaluate.labels import Clip
     from wallcli.evaluate.run import _row, report
 
     clip = Clip("walking.mp4", tmp_path / "walking.mp4", 1, "walking", None, 1)
     answer = {"label": 1, "confident": False, "probabilities": [0.0, 1.0, 0.0], "signal_db": -3.41,
-              "reason": "'1 person' at signal -3.4 dB: ... (97 % needed; under 0 dB)"}
+              "reason": "'1 person' at signal -3.4 dB: ... (97 % needed; under 0 dB)", "column_snr_db": 19.12}
     row = _row(clip, {"result": answer, "snr_db": 6.8, "snr_block": 8}, "count", has_snr=False)
-    assert (row["band"], row["signal_db"], row["snr_db"]) == ("<0 dB", -3.41, 6.8)
+    assert (row["band"], row["column_snr_db"], row["signal_db"], row["snr_db"]) == (">=10 dB", 19.12, -3.41, 6.8)
     labelled = Clip("walking.mp4", tmp_path / "walking.mp4", 1, "walking", None, 1, snr_db=12.0)
     assert _row(labelled, {"result": answer, "snr_db": 6.8}, "count", has_snr=True)["band"] == ">=10 dB"
     res = report([row], task="count", model={"name": "m", "version": "1", "sha256": "0"}, classes=[0, 1, 2],
                  folder="d", labels="labels.csv", skipped=[], stride=64, roi=None)
-    assert [b["clips"] for b in res["by_band"]] == [0, 1, 0, 0] and "signal_db" in res["band_measure"]
+    assert [b["clips"] for b in res["by_band"]] == [0, 0, 0, 1] and res["band_measure"].startswith("column_snr_db")
+    assert (res["snr_source"], res["snr_figure"]) == ("measured", "column_snr_db")
     print_evaluation(res)
     out = " ".join(capsys.readouterr().out.split())
-    assert "By signal band" in out and "walking.mp4 1 1 ? 100 yes -3.4" in out
+    assert "By column SNR band" in out and "walking.mp4 1 1 ? 100 yes 19.1" in out and "column SNR dB" in out
 
 
 def test_amplify_names_its_own_snr(tmp_path, run_cli):

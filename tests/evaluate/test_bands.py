@@ -84,30 +84,32 @@ def test_min_snr_leaves_quiet_clips_out_of_every_figure(with_snr, run_cli, floor
 
 @pytest.mark.slow
 def test_without_an_snr_column_bands_are_on_the_measured_snr(labelled, run_cli):
-    """... that is, on the answers' signal_db (issue 54: the figure their reasons quote and their
-    thresholds are per band of), not on the block SNR of rows[].snr_db."""
+    """... that is, on the column SNR of the same decode (issue 61.1: column_snr_db, the figure every
+    command prints first), not on the block SNR of rows[].snr_db nor the answers' signal_db."""
     code, out, err = run_cli("evaluate", labelled, "--task", "count", "--json", "--jobs", "2")
     assert code == 0, err
     res = json.loads(out)
-    assert res["snr_source"] == "measured" and res["band_measure"].startswith("signal_db")
+    assert res["snr_source"] == "measured" and res["band_measure"].startswith("column_snr_db")
+    assert res["snr_figure"] == "column_snr_db"
     for r in res["rows"]:
-        assert r["band"] == band_of(r["truth"] == 0, r["signal_db"]) and r["snr_db_labels"] is None
+        assert r["band"] == band_of(r["truth"] == 0, r["column_snr_db"]) and r["snr_db_labels"] is None
+        assert (r["column_snr_db"] is None) == (r["error"] is not None)  # every analysed clip has one
     # clips that failed have no measured SNR: a fifth band, so that every scored clip is counted
     assert [b["band"] for b in res["by_band"]] == ["empty", "<0 dB", "0-10 dB", ">=10 dB", "not measured"]
     assert res["by_band"][-1]["clips"] == 2 and sum(b["clips"] for b in res["by_band"]) == res["clips"] == 9
     for b in res["by_band"]:
         assert [b["clips"], b["correct"], b["decided"], b["correct_decided"]] == _figures(res["rows"], b["band"])
 
-    movers = sorted(r["signal_db"] for r in res["rows"] if r["band"] not in ("empty", "not measured"))
+    movers = sorted(r["column_snr_db"] for r in res["rows"] if r["band"] not in ("empty", "not measured"))
     floor = (movers[1] + movers[2]) / 2
     code, out, err = run_cli("evaluate", labelled, "--task", "count", "--json", "--jobs", "2", "--min-snr", floor)
     cut = json.loads(out)
-    gone = [r["file"] for r in res["rows"] if r["band"] != "empty" and (r["signal_db"] is None or r["signal_db"] < floor)]
+    gone = [r["file"] for r in res["rows"] if r["band"] != "empty" and (r["column_snr_db"] is None or r["column_snr_db"] < floor)]
     assert cut["excluded_files"] == gone and len(gone) == 4 and cut["clips"] == 5
     assert all(r in res["rows"] for r in cut["rows"])
 
     code, out, err = run_cli("evaluate", labelled, "--task", "count", "--jobs", "2")
-    assert "The labels give no snr_db: bands are on the answers' measured signal (signal_db" in _flat(out)
+    assert "The labels give no snr_db: bands are on the measured column SNR (column_snr_db" in _flat(out)
 
 
 @pytest.mark.slow

@@ -13,9 +13,9 @@ def _result():
 
     rows = [_row("empty.mp4", 0, 0), _row("standing.mp4", 0, 0), _row("faint.mp4", 1, 0, confident=False),
             _row("mid.mp4", 1, 1), _row("loud.mp4", 1, 1), _row("bad.mp4", 1, None, error="bad clip")]
-    # the block SNR (snr_db) and the answers' signal (signal_db, what the bands are on) differ
-    for r, snr, signal in zip(rows, (-3, -2, 7.0, 8.0, 30.0, None), (-20, -15, -4.0, 5.0, 12.0, None)):
-        r["snr_db"], r["signal_db"] = snr, signal
+    # the block SNR (snr_db), the answers' signal_db and the column SNR (what the bands are on) differ
+    for r, snr, column in zip(rows, (-3, -2, 7.0, 8.0, 30.0, None), (-20, -15, -4.0, 5.0, 12.0, None)):
+        r["snr_db"], r["signal_db"], r["column_snr_db"] = snr, (None if snr is None else snr - 9), column
     return report(rows, task="count", model={"name": "m", "version": "1", "sha256": "0"}, classes=[0, 1, 2],
                   folder="d", labels="labels.csv", skipped=[], stride=64, roi=None)
 
@@ -50,7 +50,8 @@ def test_the_plot_draws_the_tables_bands_on_the_tables_figure(monkeypatch, tmp_p
              for seg in c.get_segments()}
     inner = {x for lo_hi in spans for x in lo_hi if -30 < x < 20}
     assert 0.0 in inner and 10.0 in inner and not inner & {-5.0, 5.0}
-    # the clips are placed by signal_db (-4, 5, 12), as the table's figure, not by snr_db (7, 8, 30)
+    # the clips are placed by column_snr_db (-4, 5, 12), as the table's figure, not by snr_db (7, 8, 30)
+    # nor signal_db (-2, -1, 21)
     xs = sorted(float(x) for c in ax_s.collections if hasattr(c, "get_offsets") and len(c.get_offsets())
                 and c.get_label() in ("right", "wrong") for x in c.get_offsets()[:, 0])
     from wallcli.plots.reliability import NOBODY_X

@@ -23,6 +23,7 @@ def _result(n: int, skipped: int) -> dict:
         rows.append({"file": f"t{i:03d}_p1_{truth}.mp4", "truth": truth, "label": None if err else label,
                      "confident": None if err else i % 3 == 0, "probabilities": None if err else p,
                      "snr_db": None if err else -20.0 + i, "signal_db": None if err else -30.0 + i / 2,
+                     "column_snr_db": None if err else -10.0 + i / 4,
                      "detectable": i % 4 != 1, "error": err,
                      "reason": f"p=0.{i:03d} for '{label}' at signal {i - 20} dB: answers like this were right 97 % of "
                                "the time in validation only from p=0.994"})
@@ -43,11 +44,11 @@ def test_sixty_clips_fit_80_columns_one_line_each(monkeypatch, capsys):
     lines = capsys.readouterr().out.splitlines()
     assert max(len(x) for x in lines) <= 80
     assert lines[:2] == ["transfer (labels: labels.csv)", "activity by wallcli-activity 0.3.1, 60 clips"]
-    order = [next(i for i, x in enumerate(lines) if x.startswith(t)) for t in ("By signal band", "Summary", "Confusion",
+    order = [next(i for i, x in enumerate(lines) if x.startswith(t)) for t in ("By column SNR band", "Summary", "Confusion",
                                                                                "activity by wallcli-activity 0.3.1, per clip")]
     assert order == sorted(order)  # bands and decided figures first, the clips last
     head = lines[order[-1] + 1]
-    assert head.split() == ["file", "det", "truth", "answer", "p", "%", "right", "signal", "dB"]
+    assert head.split() == ["file", "det", "truth", "answer", "p", "%", "right", "column", "SNR", "dB"]
     top = order[-1] + 2  # the rule under the header
     assert lines[top].startswith("─")
     clip_lines = lines[top + 1:top + 61]
@@ -60,11 +61,11 @@ def test_sixty_clips_fit_80_columns_one_line_each(monkeypatch, capsys):
         else:
             shown = cells[3:5] if r["confident"] is False else cells[3:4]
             assert shown == ([r["label"], "?"] if r["confident"] is False else [r["label"]])
-            assert ("yes" if r["correct"] else "no") in cells and cells[-1] == f"{r['signal_db']:.1f}"
+            assert ("yes" if r["correct"] else "no") in cells and cells[-1] == f"{r['column_snr_db']:.1f}"
     rest = "\n".join(lines[top + 61:])
     above = " ".join(" ".join(lines[order[-2]:order[-1]]).split())  # between the confusion and the clips
-    # the columns' meaning heads the table; without the labels' snr_db, the bands are on the answers' signal
-    assert "?: undetermined" in above and "signal dB: the answer's measured signal" in above
+    # the columns' meaning heads the table; without the labels' snr_db, the bands are on the column SNR
+    assert "?: undetermined" in above and "column SNR dB: the measured column SNR" in above
     assert "only from p=" not in "\n".join(lines) and "[1]" not in "\n".join(lines)
     assert "Invalid data found" in rest and "1 clip skipped: more than one person" in "\n".join(lines)
     assert len(lines) <= 60 + 50  # one line a clip, plus the figures

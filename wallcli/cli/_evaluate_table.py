@@ -26,11 +26,11 @@ def _of(k: int, n: int, digits: int = 0) -> str:
 
 
 def _snr(r: dict, labels: bool) -> str:
-    # the figure the bands are on: labels.csv's SNR where it has the column, else the answer's
-    # measured signal (signal_db), the figure its reason quotes
+    # the figure the bands are on: labels.csv's SNR where it has the column, else the measured
+    # column SNR (column_snr_db, the headline figure every command prints first)
     from wallcli.wording import format_db
 
-    value = r.get("snr_db_labels", r["snr_db"]) if labels else r.get("signal_db")
+    value = r.get("snr_db_labels", r["snr_db"]) if labels else r.get("column_snr_db")
     return "-" if value is None else format_db(value)
 
 
@@ -39,7 +39,7 @@ def _clips(res: dict, show_det: bool) -> None:
     right or not, and the SNR its band is on. Reasons and errors are in the JSON, not here: a
     footnote a row made 265 lines of 120 clips."""
     labels = res["snr_source"] == "labels"
-    figure = "SNR dB" if labels else "signal dB"  # each figure by its own name
+    figure = "SNR dB" if labels else "column SNR dB"  # each figure by its own name
     cols = ["file", "truth", "answer", "p %", "right", figure]
     if show_det:
         cols.insert(1, "det")
@@ -56,7 +56,7 @@ def _clips(res: dict, show_det: bool) -> None:
         rows.append(row)
     m = res["model"]
     what = ("labels.csv snr_db (the bands' SNR)" if labels else
-            "the answer's measured signal, as its reason quotes it (signal_db; the bands are on it)")
+            "the measured column SNR, the figure every command prints first (column_snr_db; the bands are on it)")
     # what the columns mean above them, the title last: it is one unwrapped line right over its table
     print_lines(["?: undetermined, the most likely answer shown (why: --json, rows[].reason); "
                  f"p %: its probability; {figure}: {what}" + ("; det: labelled detectable" if show_det else "")])
@@ -83,11 +83,11 @@ def _bands(res: dict) -> None:
              _of(b["correct_decided"], b["decided"])] for b in res["by_band"]]
     labels = res["snr_source"] == "labels"
     scored = plural(sum(b["clips"] for b in res["by_band"]), "scored clip")
-    print_table(f"By {'SNR' if labels else 'signal'} band, all {scored} "
-                f"({'SNR: labels.csv snr_db' if labels else 'measured signal_db'})",
+    print_table(f"By {'SNR' if labels else 'column SNR'} band, all {scored} "
+                f"({'SNR: labels.csv snr_db' if labels else 'measured column_snr_db'})",
                 ["band", "clips", "right", "decided", "right of decided"], rows)
-    lines = [] if labels else ["The labels give no snr_db: bands are on the answers' measured signal (signal_db, the "
-                               "figure their reasons quote; see the signal column)."]
+    lines = [] if labels else ["The labels give no snr_db: bands are on the measured column SNR (column_snr_db, the "
+                               "figure every command prints first, on the labels' scale; see the column SNR column)."]
     if res.get("min_snr") is not None:
         lines.append(f"--min-snr {res['min_snr']:g}: {plural(res['excluded'], 'clip')} under {res['min_snr']:g} dB "
                      "left out of every figure")

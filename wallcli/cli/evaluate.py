@@ -27,8 +27,8 @@ def evaluate(
     jobs: int = number_option(0, "--jobs", "-j", lo=0, hi=MAX_THREADS, integer=True,
                               help="Clips analysed at once, one process each (0 = one per core; at most 4 per core)."),
     min_snr: Optional[float] = number_option(None, "--min-snr", lo=-99, hi=99, help="Score only clips where nobody "
-                                             "moves and clips whose SNR in dB (labels.csv's snr_db, else the answer's measured "
-                                             "signal, signal_db) is at least this; the others are left out of every figure and counted."),
+                                             "moves and clips whose SNR in dB (labels.csv's snr_db, else the measured column "
+                                             "SNR, column_snr_db) is at least this; the others are left out of every figure and counted."),
     roi: Optional[str] = typer.Option(None, "--roi", help=ROI_HELP + " Applies to every clip."),
     force: bool = typer.Option(False, "--force", help=force_help("the --plot PNG (the only file evaluate writes)")),
     strict: bool = strict_option(),
@@ -44,11 +44,12 @@ def evaluate(
 
     Each clip is decoded once, classified exactly as 'wallcli count' / 'activity' would
     (same model, windows and stride; the answer's signal_db is the figure its reason
-    quotes) and its block SNR measured too (snr_db: green channel, wallcli snr's estimator
-    at the block size of one space-time plot bin). Prints first the clips right by band
+    quotes) and its figures measured from the same decode: the column SNR (column_snr_db,
+    the headline every command prints first) and the block SNR (snr_db: green channel,
+    wallcli snr's estimator at the block size of one space-time plot bin). Prints first the clips right by band
     (nobody moving, under 0 dB, 0-10 dB, 10 dB and over: on labels.csv's snr_db column where
-    there is one, else on the answers' signal_db, the figure the decided/undetermined
-    thresholds are per band of), accuracy with its exact 95 %
+    there is one, else on the measured column SNR, column_snr_db, the figure every
+    command prints first, on the labels' scale), accuracy with its exact 95 %
     interval (Clopper-Pearson, over clips), how many answers were decided (not
     'undetermined') and how often those were right, and the confusion matrix with accuracy per class; then one line per
     clip: the answer ('?' after it when undetermined; why: --json), the truth, right or

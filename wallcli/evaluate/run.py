@@ -101,7 +101,7 @@ def evaluate_folder(folder: str | Path, task: str, *, model_path: str | Path | N
                            f"{rows[0]['error']})")
     excluded = list(plan.excluded)
     if plan.min_snr is not None and not has_snr:  # only now is the measured SNR known
-        keep = [r["band"] == "empty" or _at_least(r["signal_db"], plan.min_snr) for r in rows]
+        keep = [r["band"] == "empty" or _at_least(r["column_snr_db"], plan.min_snr) for r in rows]
         excluded += [r["file"] for r, k in zip(rows, keep) if not k]
         rows = [r for r, k in zip(rows, keep) if k]
     if not rows:
@@ -122,10 +122,11 @@ def _row(clip: Clip, out: dict, task: str, has_snr: bool) -> dict[str, Any]:
     res = out.get("result")
     err = out.get("error")
     snr = out.get("snr_db")
-    # the measured bands are on the answers' own figure (signal_db, which the decided/undetermined
-    # thresholds are per band of), not on the block SNR in snr_db: a clip was put in "0-10 dB" by
-    # one figure while its answer's reason said "under 0 dB" by the other
+    # the measured bands are on the headline column SNR (wallcli.snr.column: the figure every
+    # command prints first, on the labels' scale, from the same decode), not on the block SNR in
+    # snr_db nor on the answers' signal_db: the README's bands are on that scale (issue 61.1)
     signal = res.get("signal_db") if res else None
+    column = res.get("column_snr_db") if res else None
     return {
         "file": clip.file,
         "truth": clip.truth(task),
@@ -135,6 +136,7 @@ def _row(clip: Clip, out: dict, task: str, has_snr: bool) -> dict[str, Any]:
         "probabilities": res["probabilities"] if res else None,
         "snr_db": snr,
         "signal_db": signal,
+        "column_snr_db": column,
         "detectable": clip.detectable,
         "error": err,
         "reason": res.get("reason") if res else None,
@@ -144,7 +146,7 @@ def _row(clip: Clip, out: dict, task: str, has_snr: bool) -> dict[str, Any]:
         "windows": res.get("windows_n") if res else None,
         "warnings": out.get("warnings", []),
         "snr_db_labels": clip.snr_db,
-        "band": score.band_of(clip.empty(task), clip.snr_db if has_snr else signal),
+        "band": score.band_of(clip.empty(task), clip.snr_db if has_snr else column),
     }
 
 
@@ -155,7 +157,7 @@ def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: s
     for r in rows:
         r["correct"] = score.correct(r)
         if "band" not in r:  # rows from elsewhere: the truth says which rooms are empty
-            r["band"] = score.band_of(r["truth"] in (0, "none"), r.get("signal_db"))
+            r["band"] = score.band_of(r["truth"] in (0, "none"), r.get("column_snr_db"))
     given = any(r["detectable"] is not None for r in rows)
     # unknown detectability (a blank cell) counts as detectable: only a stated 0 leaves the headline
     head = [r for r in rows if r["detectable"] is not False] if given else rows
@@ -189,9 +191,11 @@ def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: s
         # bands over every scored clip, detectable or not: where a model stops working is the point
         "by_band": score.by_band(rows),
         "snr_source": snr_source,
+        # the row field the bands (and a measured --min-snr) are on; snr_source keeps its values
+        "snr_figure": "snr_db_labels" if snr_source == "labels" else "column_snr_db",
         "band_measure": ("labels.csv's snr_db" if snr_source == "labels" else
-                         "signal_db, the answers' signal (the figure count's and activity's reasons quote and "
-                         "their decided/undetermined thresholds are per band of), not the block SNR in snr_db"),
+                         "column_snr_db, the column SNR (the headline figure every command prints first, on "
+                         "the labels' scale), not the block SNR in snr_db nor the answers' signal_db"),
         "min_snr": min_snr,
         "excluded": len(excluded),
         "excluded_files": list(excluded),
@@ -203,6 +207,6 @@ def report(rows: list[dict], *, task: str, model: dict, classes: list, folder: s
         "roi": list(roi) if roi else None,
         "interval": {"method": "clopper-pearson", "level": 0.95},
         "snr_measure": "green-channel SNR (wallcli snr's estimator) at the block size nearest one space-time "
-                       "plot bin's area; see snr_block per row; the measured bands are on signal_db, not on it",
+                       "plot bin's area; see snr_block per row; the measured bands are on column_snr_db, not on it",
     })
     return out

@@ -3,7 +3,7 @@ seeing? Left, a reliability diagram: the clip answers binned by their probabilit
 accuracy against its mean confidence (on the diagonal = calibrated), with its clip count, and
 the calibration error (ECE) explained under it. Right, the clips right or wrong by band: the
 terminal table's bands (nobody moving, under 0 dB, 0-10 dB, 10 dB and over) on the table's own
-figure (labels.csv's snr_db, else the answers' signal_db), each band's share right drawn over it.
+figure (labels.csv's snr_db, else the measured column SNR, column_snr_db), each band's share right drawn over it.
 The right panel used to draw other bands (-5, 0, 5, 10 dB edges) on another figure (the block SNR),
 so the figure and the table disagreed about the same clips."""
 from __future__ import annotations
@@ -50,7 +50,7 @@ def _reliability(ax, result: dict) -> None:
 
 def _figure(row: dict, labels: bool):
     """The figure a row's band is on, as the terminal's table shows it (cli/_evaluate_table._snr)."""
-    return row.get("snr_db_labels", row.get("snr_db")) if labels else row.get("signal_db")
+    return row.get("snr_db_labels", row.get("snr_db")) if labels else row.get("column_snr_db")
 
 
 def _bands(ax, result: dict) -> None:
@@ -99,7 +99,7 @@ def _bands(ax, result: dict) -> None:
     ax.set_ylim(-0.1, 1.22)
     ax.set_yticks([0, 0.25, 0.5, 0.75, 1])
     what = ("SNR from labels.csv's snr_db (dB)" if labels else
-            "measured signal (signal_db, dB: the figure the answers' reasons quote)")
+            "measured column SNR (column_snr_db, dB: the figure every command prints first)")
     ax.set_xlabel(what + "\nbands and figure as in the terminal's table" +
                   (f"; {unplaced} clip(s) without a figure not drawn" if unplaced else ""), fontsize=9)
     ax.set_ylabel("right (1) / wrong (0); bars: share right per band")
