@@ -209,25 +209,36 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
     """
     from wallcli.camera.tnr import bound_result
     from wallcli.io.video import open_video
+    from wallcli.snr.column import ColumnSnr, bins_column_snr_db
 
     # the classifier of classify_video, so that the lines are its windows (and its clip answer)
     classifier = WindowClassifier(model, stride, corrections=corrections)
+    column = ColumnSnr(roi)  # the clip's headline figure, as classify_video measures it
     with open_video(source, threads=threads) as reader:
         classifier.native_fps = lambda: video_fps(reader)  # the frames' own rate, as stplot records it
+        column.fps = float(reader.info.fps)
         # cleaned as in classify_video (a line lists no corrections of the clip's)
-        decode = _Decode(model, reader, roi=roi, corrections=corrections)
+        decode = _Decode(model, reader, roi=roi, corrections=corrections, taps=(column,))
         rows = decode.rows
         for t, row in rows:
             n = len(classifier.times)
             classifier.push(t, stream_row(row, rows), rows.ref)
             if len(classifier.times) > n:
                 rec = window_record(model, classifier.times[-1], classifier.probs[-1], classifier.signal[-1])
+                # the window's column SNR from its own plot bins, as count reads a .npz's (a window
+                # is one of the figure's 256-sample chunks: about a millisecond)
+                rec["column_snr_db"] = bins_column_snr_db(classifier.last_rows[:model.bins], model.fps, rows.roi[2])
                 rec |= {"corrections": corr.merge([classifier.found[-1]])}
                 # what the frames so far say of the noise (a window holds 256 of them)
                 rec = judge_view(rec, decode.check.view(rec["start"], rec["end"]))
                 yield bound_result(rec, decode.blend.correction())
         decode.refuse_short(classifier, str(source))
     result = decode.result(classifier, str(source))
+    result["column_snr_db"] = column.db()  # the clip's, as count --json gives it
     if len(result["windows"]) > len(classifier.times):  # the end-aligned last window
-        yield result["windows"][-1]
+        last = dict(result["windows"][-1])
+        tail = classifier.windower.pending()
+        last["column_snr_db"] = (bins_column_snr_db(tail[2][:model.bins], model.fps, rows.roi[2])
+                                 if tail is not None else None)
+        yield last
     yield result

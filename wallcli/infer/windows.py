@@ -143,11 +143,13 @@ class WindowStream:
         self.windower = StreamWindower(model.window, stride, model.fps)
         self.times, self.probs, self.signal, self.found = [], [], [], []
         self.ref = None
+        self.last_rows = None  # the rows of the window completed last (valid until the next push)
 
     def push(self, t: float, row: np.ndarray, ref: np.ndarray) -> None:
         self.ref = ref
         done = self.windower.push(t, row)
         if done is not None:
+            self.last_rows = done[2]
             p, db, f = predict_window(self.model, done[2], ref, start=done[0], native=self.native(),
                                       options=self.corrections)
             self.times.append(done[0])

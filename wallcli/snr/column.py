@@ -142,12 +142,18 @@ class ColumnSnr:
 def plot_column_snr_db(plot) -> float | None:
     """The figure from a space-time plot (a .npz): its horizontal bins stand for columns, their
     noise scaled up by the columns each bin averages (``meta['roi']``), as independent noise is."""
-    h = np.asarray(plot.horizontal, np.float64).mean(axis=-1).T  # (T, bins)
     t = np.asarray(plot.time, np.float64)
     fps = (len(t) - 1) / (t[-1] - t[0]) if len(t) > 1 and t[-1] > t[0] else 30.0
-    signal = noise = 0.0
     roi = (plot.meta or {}).get("roi")
-    per_bin = max(float(roi[2]) / h.shape[1], 1.0) if roi else 1.0
+    return bins_column_snr_db(plot.horizontal, fps, float(roi[2]) if roi else None)
+
+
+def bins_column_snr_db(horizontal, fps: float, roi_width: float | None) -> float | None:
+    """The figure from horizontal plot bins (bins, T, channels), each bin averaging ``roi_width`` /
+    bins columns: a whole plot's, or one window's (count --follow's lines)."""
+    h = np.asarray(horizontal, np.float64).mean(axis=-1).T  # (T, bins)
+    signal = noise = 0.0
+    per_bin = max(float(roi_width) / h.shape[1], 1.0) if roi_width else 1.0
     for i in range(0, h.shape[0], CHUNK):
         s, n, _ = chunk_powers(h[i:i + CHUNK], fps, per_bin)
         signal, noise = signal + s, noise + n
