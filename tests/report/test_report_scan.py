@@ -67,6 +67,7 @@ def test_the_column_snr_is_the_first_figure_and_each_figure_is_named(index):
     assert heads[2] == "column SNR (dB)"
     assert heads.index("pixel SNR G (dB)") > heads.index("activity")
     assert [h for h in heads if "SNR" in h] == ["column SNR (dB)", "pixel SNR G (dB)"]
+    assert heads.count("signal_db (dB)") == 2  # each answer's own figure, by its JSON name
     note = " ".join(parse(index).by_id("videos").text().split())
     assert "Column SNR is the results' column_snr_db" in note
 
