@@ -202,6 +202,9 @@ def accuracy_note(card: dict, single_stage: bool = False, unvalidated: str | Non
     windows is not a 90 % answer. An unvalidated card (``unvalidated``: why, infer/trust.py) has
     no figure worth quoting: the line says so instead.
     """
+    if unvalidated:
+        return (f"{card.get('name', 'model')} {card.get('version', '')}: {unvalidated}; none of its "
+                "validation figures are quoted and no answer is decided.")
     tr = card.get("transfer") or {}
     if single_stage and tr.get("stages"):  # the card's headline is the two-stage count's, not this net's alone
         tr = card.get("transfer_single_stage") or {}
@@ -210,9 +213,6 @@ def accuracy_note(card: dict, single_stage: bool = False, unvalidated: str | Non
         iv = tr.get("ci95")
         ci = f" (95 % CI {iv[0]:.0%}-{iv[1]:.0%})" if isinstance(iv, list) and len(iv) == 2 else ""
         dec = ""
-    if unvalidated:
-        return (f"{card.get('name', 'model')} {card.get('version', '')}: {unvalidated}; none of its "
-                "validation figures are quoted and no answer is decided.")
         if isinstance(tr.get("coverage"), (int, float)) and isinstance(tr.get("accuracy_decided"), (int, float)):
             dec = f"; it decided {tr['coverage']:.0%} of them and was right on {tr['accuracy_decided']:.0%} of those"
         st = tr.get("stages") if isinstance(tr.get("stages"), dict) else None
