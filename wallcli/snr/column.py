@@ -112,9 +112,17 @@ class ColumnSnr:
 
     def push(self, planes) -> None:
         if self.roi is None:
+            from wallcli.errors import WallcliError
             from wallcli.signal.blocks import check_roi
 
-            self.roi = check_roi(self.requested, planes.width, planes.height)
+            try:
+                self.roi = check_roi(self.requested, planes.width, planes.height)
+            except WallcliError:
+                # a frame under one chroma sample each way (1x1000): the command's own checks
+                # answer for it; the headline figure is then not measured, never an error
+                self.roi = False
+        if self.roi is False:
+            return
         self._rows.append(_luma(planes, self.roi))
         if len(self._rows) >= CHUNK:
             self._flush()
