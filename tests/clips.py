@@ -114,3 +114,19 @@ def one_error(err: str) -> str:
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in err, err
     return lines[0]
+
+
+# a small simulated walker: a window fits and a decode takes a fraction of a second
+SIM = ["--size", "64x48", "--duration", "10.5", "--fps", "30", "--grid", "16x16", "--crf", "12"]
+
+
+def simulated_walk(path: Path) -> Path:
+    """``wallcli simulate`` one walker (seed 1) to ``path``, in process."""
+    import pytest
+
+    from wallcli.cli.app import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["simulate", "-o", str(path), "--people", "1", "--activity", "walking", "--seed", "1", *SIM])
+    assert exit_.value.code == 0
+    return path

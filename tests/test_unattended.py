@@ -17,22 +17,15 @@ import time
 from pathlib import Path
 
 import pytest
-from clips import one_error, tiny_clip, write_plot
+from clips import one_error, simulated_walk, tiny_clip, write_plot
 
-SIM = ["--size", "64x48", "--duration", "10.5", "--fps", "30", "--grid", "16x16", "--crf", "12"]
 WALLCLI = [sys.executable, "-m", "wallcli"]
 
 
 @pytest.fixture(scope="module")
 def video(tmp_path_factory) -> Path:
     """One short simulated clip (a window fits; a decode takes a fraction of a second)."""
-    from wallcli.cli.app import main
-
-    path = tmp_path_factory.mktemp("video") / "walk.mp4"
-    with pytest.raises(SystemExit) as exit_:
-        main(["simulate", "-o", str(path), "--people", "1", "--activity", "walking", "--seed", "1", *SIM])
-    assert exit_.value.code == 0
-    return path
+    return simulated_walk(tmp_path_factory.mktemp("video") / "walk.mp4")
 
 
 @pytest.fixture
