@@ -74,3 +74,27 @@ def test_the_check_sees_a_moved_answer():
     tr["tracks"][0]["samples"][0][1] += 0.01
     with pytest.raises(AssertionError):
         _same("track", tr, GOLDEN["track/walking"], "track")
+
+
+RECORDINGS = HERE.parent.parent / "shared" / "transfer"
+
+
+def _recordings():
+    return sorted(RECORDINGS.glob("*.mp4"))[::16] if RECORDINGS.is_dir() else []
+
+
+@pytest.mark.skipif(not RECORDINGS.is_dir(), reason="../shared/transfer (the recordings) is not beside the checkout")
+@pytest.mark.parametrize("clip", _recordings(), ids=lambda p: p.stem)
+def test_answers_unchanged_on_the_recordings(clip, tmp_path):
+    # a sixteenth of the 229 recordings (96x72, where every check reads its frames whole, unlike 1080p's
+    # lattices); tests/golden/check_recordings.py runs them all
+    import gzip
+
+    from wallcli.cli.app import main
+
+    golden = json.loads(gzip.decompress((HERE / "golden" / "recordings.json.gz").read_bytes()))
+    for task in make_answers.TASKS:
+        code, r, npz = make_answers.run(main, task, clip, tmp_path)
+        assert code == 0, f"{task} {clip.name}"
+        key = f"{task}/{clip.stem}"
+        _same(task, make_answers.summarise(task, r, npz), golden[key], key)

@@ -1,6 +1,7 @@
 """The answers of count, activity, track and stplot on the bundled examples, as a golden file (issue 60).
 
     .venv/bin/python tests/golden/make_answers.py      # writes tests/golden/answers.json
+    .venv/bin/python tests/golden/make_answers.py --clips ../shared/transfer --out tests/golden/recordings.json.gz
 
 Generated from the code before issue 60's speed work, so that tests/test_answers_golden.py can
 hold the faster code to the same answers: every label, probability, signal_db, view verdict and
@@ -10,6 +11,7 @@ track, and the stplot plots' figures. Regenerate only after a change that is mea
 from __future__ import annotations
 
 import contextlib
+import gzip
 import io
 import json
 import sys
@@ -64,18 +66,28 @@ def run(main, task: str, clip: Path, out_dir: Path) -> tuple[int, dict, Path | N
 
 
 def main() -> None:
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--clips", type=Path, default=EXAMPLES, help="folder of .mp4 clips (default: examples/)")
+    ap.add_argument("--out", type=Path, default=HERE / "answers.json")
+    a = ap.parse_args()
     from wallcli.cli.app import main as cli
 
     golden: dict = {}
     with tempfile.TemporaryDirectory() as d:
-        for clip in sorted(EXAMPLES.glob("*.mp4")):
+        for clip in sorted(a.clips.glob("*.mp4")):
             for task in TASKS:
                 code, r, npz = run(cli, task, clip, Path(d))
                 if code:
                     sys.exit(f"{task} {clip.name} exited {code}")
                 golden[f"{task}/{clip.stem}"] = summarise(task, r, npz)
-                print(f"{task} {clip.stem}", file=sys.stderr)
-    (HERE / "answers.json").write_text(json.dumps(golden, indent=0) + "\n")
+            print(clip.stem, file=sys.stderr)
+    text = json.dumps(golden, indent=0) + "\n"
+    if a.out.suffix == ".gz":  # the recordings' answers: 1.8 MB as text
+        a.out.write_bytes(gzip.compress(text.encode(), 9, mtime=0))
+    else:
+        a.out.write_text(text)
 
 
 if __name__ == "__main__":
