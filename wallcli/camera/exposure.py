@@ -35,9 +35,27 @@ def solve(design: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.linalg.pinv(design) @ y
 
 
+def median(x: np.ndarray, axis: int = -1) -> np.ndarray:
+    """``np.median`` of real ``x`` along ``axis``, the same values, by a full sort: numpy sorts a
+    contiguous last axis with SIMD, while its median partitions on two order statistics without
+    (0.06 against 0.6-0.8 ms for a window's (256, 128) series)."""
+    x = np.asarray(x, np.float64)
+    if x.ndim == 0 or x.shape[axis] == 0:
+        return np.median(x, axis=axis)
+    s = np.sort(x, axis=axis)
+    if axis not in (-1, s.ndim - 1):
+        s = np.moveaxis(s, axis, -1)
+    n = s.shape[-1]
+    mid = s[..., n // 2] if n % 2 else (s[..., n // 2 - 1] + s[..., n // 2]) / 2.0
+    # NaN sorts last; np.median is NaN wherever one was
+    if s.ndim == 1:
+        return np.float64(np.nan) if np.isnan(s[-1]) else mid
+    return np.where(np.isnan(s[..., -1]), np.nan, mid)
+
+
 def _robust_gain(rel: np.ndarray) -> np.ndarray:
     """The whole frame's relative gain per sample: the median over the series of (T, K)."""
-    return np.median(rel, axis=1)
+    return median(rel, axis=1)
 
 
 def _legendre(t: int, degree: int) -> np.ndarray:
@@ -238,9 +256,10 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
     g = _robust_gain(rel)
     basis = _legendre(t, degree)  # degree: of the drift's polynomial
     dg = np.diff(g)
-    noise = 1.4826 * np.median(np.abs(dg - np.median(dg))) / np.sqrt(2.0)
-    db = np.diff(rel, axis=0)
-    sigma = 1.4826 * np.median(np.abs(db - np.median(db, axis=0)), axis=0) / np.sqrt(2.0)  # (K,) per bin
+    noise = 1.4826 * median(np.abs(dg - median(dg))) / np.sqrt(2.0)
+    rt = np.ascontiguousarray(rel.T)
+    db = rt[:, 1:] - rt[:, :-1]  # (K, T - 1): each bin's differences along a contiguous axis, for the sort
+    sigma = 1.4826 * median(np.abs(db - median(db)[:, None])) / np.sqrt(2.0)  # (K,) per bin
     ramp = max(2, int(round(RAMP_S * rate)))
     span = max(4, int(round(SPAN_S * rate)))
     half = ramp // 2
@@ -299,7 +318,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
                 mid = int(round(0.5 * (where[0] + where[1])))
                 if (mid != j and abs(mid - j) <= half and idx[0] <= mid <= idx[-1]
                         and all(abs(mid - k) >= half + hk for k, hk in zip(found, halves))):
-                    size_at = [abs(np.median(_local_steps(rel - others[:, None], w, i, half, span))) for i in (j, mid)]
+                    size_at = [abs(median(_local_steps(rel - others[:, None], w, i, half, span))) for i in (j, mid)]
                     if size_at[1] > size_at[0]:
                         j = mid
                         nb, na = counts(j)
@@ -309,7 +328,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
             ok = hj >= 0
             if ok:
                 per_bin = _local_steps(rel - others[:, None], w, j, hj, span)
-                common = np.array([np.median(per_bin)])
+                common = np.array([median(per_bin)])
                 tol = 4 * sigma * np.sqrt(1.0 / nb + 1.0 / na)
                 ok = abs(common[0]) >= thr and _agree(per_bin[:, None], common, tol, part)
         if ok:
@@ -324,7 +343,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
         # them: size it again with the others' sizes taken out
         for i, j in enumerate(found):
             if any(abs(j - k) < halves[i] + hk + span for k, hk in zip(found, halves) if k != j):
-                sizes[i] = float(np.median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
+                sizes[i] = float(median(_local_steps(rel - stepped(i)[:, None], w, j, halves[i], span)))
     ends = _open_ends(g, rel, w, basis, found, thr, noise, sigma, half + least + 1, part)
     for lo, hi, _, _ in ends:
         w[lo:hi] = 0.0
@@ -347,7 +366,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
     for lo, hi in ramps:  # within a ramp the step's shape is what was measured, not a jump
         around = np.arange(max(lo - span, 0), min(hi + span, t))
         around = around[keep[around]]
-        model[lo:hi] = g[lo:hi] - (np.median((g - model)[around]) if around.size else 0.0)
+        model[lo:hi] = g[lo:hi] - (median((g - model)[around]) if around.size else 0.0)
     # each step's size as the model has it: the change across its ramp (where two ramps touch, the
     # level between them is only seen there, not in the fitted jumps)
     steps = [(j, float(np.mean(model[min(j + hj + 1, t - 1):min(j + hj + 3, t)])
