@@ -11,6 +11,8 @@ levels: gains add.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 STEP_MIN = 0.003  # relative size of the smallest exposure step removed
@@ -58,9 +60,14 @@ def _robust_gain(rel: np.ndarray) -> np.ndarray:
     return median(rel, axis=1)
 
 
-def _legendre(t: int, degree: int) -> np.ndarray:
-    x = np.linspace(-1.0, 1.0, t)
-    return np.polynomial.legendre.legvander(x, degree)
+@lru_cache(maxsize=16)
+def _legendre(t: int, degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """(Legendre basis (t, degree + 1), its pseudo-inverse): the same for every window of a length
+    (read only)."""
+    basis = np.polynomial.legendre.legvander(np.linspace(-1.0, 1.0, t), degree)
+    pinv = np.linalg.pinv(basis)
+    basis.flags.writeable = pinv.flags.writeable = False
+    return basis, pinv
 
 
 def _agree(per_bin: np.ndarray, common: np.ndarray, tol: np.ndarray, part: np.ndarray | None = None,
@@ -101,17 +108,23 @@ def _masked_means(r: np.ndarray, w: np.ndarray, idx: np.ndarray, half: int, span
     where ``w`` (0/1) counts, the window's ends cutting the spans short; NaN where fewer than ``least``
     samples count on a side."""
     t = r.size
-    cs = np.concatenate([[0.0], np.cumsum(r * w)])
-    cn = np.concatenate([[0.0], np.cumsum(w)])
-    b_hi = np.clip(idx - half, 0, t)
-    b_lo = np.clip(idx - half - span, 0, t)
-    a_lo = np.clip(idx + half, 0, t)
-    a_hi = np.clip(idx + half + span, 0, t)
-    nb, na = cn[b_hi] - cn[b_lo], cn[a_hi] - cn[a_lo]
+    cs = np.zeros(t + 1)
+    np.cumsum(r * w, out=cs[1:])
+    cn = np.zeros(t + 1)
+    np.cumsum(w, out=cn[1:])
+    # the four span ends at once (b_hi, b_lo, a_lo, a_hi): this runs some 400 times a window
+    ends = np.minimum(np.maximum(np.asarray(idx)[None, :] + _ends_offsets(half, span), 0), t)
+    c, n = cs[ends], cn[ends]
+    nb, na = n[0] - n[1], n[3] - n[2]
     with np.errstate(invalid="ignore", divide="ignore"):
-        before = np.where(nb >= least, (cs[b_hi] - cs[b_lo]) / np.maximum(nb, 1), np.nan)
-        after = np.where(na >= least, (cs[a_hi] - cs[a_lo]) / np.maximum(na, 1), np.nan)
+        before = np.where(nb >= least, (c[0] - c[1]) / np.maximum(nb, 1), np.nan)
+        after = np.where(na >= least, (c[3] - c[2]) / np.maximum(na, 1), np.nan)
     return before, after
+
+
+@lru_cache(maxsize=64)
+def _ends_offsets(half: int, span: int) -> np.ndarray:
+    return np.array([[-half], [-half - span], [half], [half + span]])
 
 
 def _local_steps(rel: np.ndarray, w: np.ndarray, j: int, half: int, span: int) -> np.ndarray:
@@ -194,6 +207,14 @@ def _pair(g: np.ndarray, w: np.ndarray, j: int, ramp: int, span: int) -> tuple[i
     return None
 
 
+@lru_cache(maxsize=16)
+def _ends_pinv(t: int, degree: int, m: int) -> np.ndarray:
+    """The pseudo-inverse of the Legendre basis without its ``m`` samples at either end (read only)."""
+    pinv = np.linalg.pinv(_legendre(t, degree)[0][m:t - m])
+    pinv.flags.writeable = False
+    return pinv
+
+
 def _open_ends(g, rel, w, basis, found, thr, noise, sigma, m, part) -> list[tuple[int, int, int, float]]:
     """[(first, end, index, size)] of the stretches at the window's ends where a step of the light
     began (or ended) too close to the end for a plateau to measure it on (within ``m`` samples):
@@ -212,7 +233,10 @@ def _open_ends(g, rel, w, basis, found, thr, noise, sigma, m, part) -> list[tupl
     ww[-m:] = 0.0
     keep = ww > 0
     design = np.concatenate([basis] + [(n >= j).astype(np.float64)[:, None] for j in found], axis=1)
-    pinv = np.linalg.pinv(design[keep])
+    if not found and w.all():  # most windows: the same fit for every window of a length
+        pinv = _ends_pinv(t, basis.shape[1] - 1, m)
+    else:
+        pinv = np.linalg.pinv(design[keep])
     r = g - design @ (pinv @ g[keep])
     out = []
     for zone in (np.arange(t - 1, t - m - 1, -1), np.arange(m)):  # from the end inwards
@@ -254,7 +278,7 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
     once all are found). Works on logarithms of the levels (:func:`fit`): gains add."""
     t = rel.shape[0]
     g = _robust_gain(rel)
-    basis = _legendre(t, degree)  # degree: of the drift's polynomial
+    basis, basis_pinv = _legendre(t, degree)  # degree: of the drift's polynomial
     dg = np.diff(g)
     noise = 1.4826 * median(np.abs(dg - median(dg))) / np.sqrt(2.0)
     rt = np.ascontiguousarray(rel.T)
@@ -286,10 +310,11 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
             break
         design = np.concatenate([basis] + [(n >= j).astype(np.float64)[:, None] for j in found], axis=1)
         keep = w > 0
-        coef = solve(design[keep], g[keep])
+        coef = basis_pinv @ g if not found and keep.all() else solve(design[keep], g[keep])
         r = g - design @ coef
         before, after = _masked_means(r, w, idx, half, span, least)
-        d = np.nan_to_num(after - before)
+        d = after - before
+        d[np.isnan(d)] = 0.0
         for j in found:
             d[np.abs(idx - j) < ramp] = 0.0
         for j in blocked:  # one change is looked at once
@@ -300,7 +325,8 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
         # the plateau of d is a ramp wide: the step is where the adjacent means differ most
         cand = np.arange(max(int(idx[k]) - half, 1), min(int(idx[k]) + half + 1, t - 1))
         b2, a2 = _masked_means(r, w, cand, 0, span, least)
-        adj = np.nan_to_num(a2 - b2)
+        adj = a2 - b2
+        adj[np.isnan(adj)] = 0.0
         j = int(cand[np.argmax(np.abs(adj))]) if np.any(adj) else int(idx[k])
         nb, na = counts(j)
         ok = min(nb, na) >= 2
@@ -350,11 +376,12 @@ def _steps_and_drift(rel: np.ndarray, rate: float, part=None, degree: int = DRIF
     steps_g = stepped()
     keep = w > 0
     nb = basis.shape[1]
-    coef = solve(basis[keep], (g - steps_g)[keep])
+    pinv = basis_pinv if keep.all() else np.linalg.pinv(basis[keep])
+    coef = pinv @ (g - steps_g)[keep]
     drift = basis[:, 1:] @ coef[1:]
     ptp = float(drift.max() - drift.min())
     if ptp >= DRIFT_MIN:
-        cb = solve(basis[keep], (rel - steps_g[:, None])[keep])
+        cb = pinv @ (rel - steps_g[:, None])[keep]
         per_bin = (basis[:, 1:] @ cb[1:nb]).T  # (K, T)
         tol = 3 * sigma * np.sqrt((nb - 1) / keep.sum())
         if DRIFT_AGREE and not _agree(per_bin, drift, tol, part, UNEVEN_DRIFT):
