@@ -90,7 +90,7 @@ class _Decode:
     check and the noise-blend measure (and any ``taps``) fed the same frames beside the rows."""
 
     def __init__(self, model, reader, *, roi, corrections: corr.Options, taps=(), progress=None, vertical=False,
-                 ahead: bool = False):
+                 ahead: bool = False, column=None):
         from wallcli.camera.pipeline import CameraPipeline
         from wallcli.camera.tnr import TemporalNoise
         from wallcli.infer.stream import RowStream
@@ -109,7 +109,7 @@ class _Decode:
         self._ahead = Ahead(frames) if ahead else None
         self.rows = RowStream(self._ahead or frames, roi=roi, bins=model.bins, fps=model.fps, progress=progress,
                               vertical=vertical or "vertical" in model.input_names or corrections.light,
-                              register=corrections.shake)
+                              register=corrections.shake, column=column)
 
     def __enter__(self) -> "_Decode":
         return self
@@ -153,15 +153,16 @@ def classify_video(model, source: str, *, stride: int, roi=None, threads: int = 
 
     classifier = WindowClassifier(model, stride, corrections=corrections)
     thumb = PlotThumbnail() if keep_plot else None
-    column = ColumnSnr(roi)  # the headline figure, from the same decode
-    taps = (*taps, column)
+    # the headline figure, from the same decode: fed by the rows' own projection, which sums the
+    # same frames' columns (as a tap it summed them again, 0.07 ms a 1080p frame)
+    column = ColumnSnr(roi)
     with open_video(source, threads=threads) as reader:
         classifier.native_fps = lambda: video_fps(reader)  # the frames' own rate, as stplot records it
-        for tap in taps:  # e.g. an SNR estimator, whose corrections need the video's own rate
+        for tap in (*taps, column):  # e.g. an SNR estimator, whose corrections need the video's own rate
             if getattr(tap, "wants_fps", False) and getattr(tap, "fps", None) is None:
                 tap.fps = float(reader.info.fps)
         with _Decode(model, reader, roi=roi, corrections=corrections, taps=taps, progress=progress,
-                     vertical=keep_plot, ahead=True) as decode:
+                     vertical=keep_plot, ahead=True, column=column) as decode:
             rows = decode.rows
             for t, row in rows:
                 if thumb is not None:
@@ -218,7 +219,7 @@ def follow(model, source: str, *, stride: int, roi=None, threads: int = 0,
         classifier.native_fps = lambda: video_fps(reader)  # the frames' own rate, as stplot records it
         column.fps = float(reader.info.fps)
         # cleaned as in classify_video (a line lists no corrections of the clip's)
-        decode = _Decode(model, reader, roi=roi, corrections=corrections, taps=(column,))
+        decode = _Decode(model, reader, roi=roi, corrections=corrections, column=column)
         rows = decode.rows
         for t, row in rows:
             n = len(classifier.times)

@@ -20,11 +20,14 @@ class RowStream:
     window's mean anyway, and subtracting it keeps float32 precise for faint signals on bright walls.
     ``roi`` and ``frame_size`` are known once the first frame is decoded. ``vertical=False``
     leaves the vertical rows at zero without computing them (for models that do not read them).
+    ``column``: a :class:`wallcli.snr.column.ColumnSnr` fed every frame with the projection's own
+    column sums, where it made them (the figure's tap would sum the same frames' columns again).
     """
 
     def __init__(self, reader, *, roi=None, bins: int = 64, fps: float = 30.0,
                  progress: Callable[[int], None] | None = None, vertical: bool = True, stabilize: bool = False,
-                 register: bool = False):
+                 register: bool = False, column=None):
+        self.column = column
         self.reader, self.requested, self.bins, self.fps, self.progress = reader, roi, int(bins), fps, progress
         self.vertical = vertical
         self.stabilize = stabilize
@@ -53,6 +56,8 @@ class RowStream:
                 reduce = RowReducer(self.roi, self.bins, self.vertical, self.stabilize, self.register)
                 self.shifts = reduce.shifts
             row = np.concatenate(reduce(frame.planes))
+            if self.column is not None:
+                self.column.push(frame.planes, reduce.column_sums())
             if getattr(frame, "gap", 0.0) > MAX_BRIDGE:  # frames lost: a new grid from here, nothing invented inside
                 resampler.restart()
             if self.ref is None:

@@ -472,6 +472,14 @@ class RgbProjector:
         with one_opencv_thread():
             return self._project(planes)
 
+    def column_sums(self) -> list[np.ndarray] | None:
+        """The last frame's column sums over ``roi`` of each plane (float32 views of exact integers,
+        valid until the next frame; chroma's over its own subsampled columns), or None where the
+        projection took its per-plane path (not 8-bit, chroma edges inside pixels, or sums past
+        float32's exact integers: see _fused_rects)."""
+        f = self._fused
+        return None if f is None else [f.lines[(p, 0)] for p in range(len(f.rects))]
+
     def _project(self, planes) -> tuple[np.ndarray, np.ndarray]:
         key = (planes.u is None, planes.sub_x, planes.sub_y, planes.kind, planes.depth, planes.matrix,
                planes.full_range)

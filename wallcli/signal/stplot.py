@@ -71,6 +71,10 @@ class RowReducer:
         """What stabilisation found (:class:`wallcli.signal.blocks.ShiftLog`)."""
         return self._project.shifts
 
+    def column_sums(self):
+        """The last frame's column sums per plane over the ROI, or None (:meth:`RgbProjector.column_sums`)."""
+        return self._project.column_sums()
+
     def __call__(self, planes) -> tuple[np.ndarray, np.ndarray]:
         return self._project(planes)
 

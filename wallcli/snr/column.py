@@ -37,16 +37,24 @@ _MEDIAN_CHI2_2 = np.log(2.0)  # a periodogram bin's median over its mean, for wh
 NAME = "column SNR"  # what every terminal calls it
 
 
-def _luma(planes, roi) -> np.ndarray:
-    """The region's column means of one frame (float64, one per column): exact integer sums."""
+def _luma(planes, roi, lines=None) -> np.ndarray:
+    """The region's column means of one frame (float64, one per column): exact integer sums.
+    ``lines``: the region's column sums of each plane where the caller made them already (the
+    projection's, :meth:`wallcli.signal.blocks.RgbProjector.column_sums`): the same integers."""
     x, y, w, h = roi
     kind = planes.y.dtype
     acc = (np.float64 if not np.issubdtype(kind, np.integer) else
            np.uint64 if h * int(np.iinfo(kind).max) >= 2 ** 32 else np.uint32)
-    if getattr(planes, "kind", "yuv") == "rgb":  # y, u, v hold R, G, B
-        sums = sum(_column_sums(p[y:y + h, x:x + w], acc) for p in (planes.y, planes.u, planes.v)) / 3.0
+    if lines is not None:
+        def column(i, _):
+            return lines[i].astype(np.float64)
     else:
-        sums = _column_sums(planes.y[y:y + h, x:x + w], acc)
+        def column(_, p):
+            return _column_sums(p[y:y + h, x:x + w], acc)
+    if getattr(planes, "kind", "yuv") == "rgb":  # y, u, v hold R, G, B
+        sums = sum(column(i, p) for i, p in enumerate((planes.y, planes.u, planes.v))) / 3.0
+    else:
+        sums = column(0, planes.y)
     return sums / h
 
 
@@ -110,7 +118,9 @@ class ColumnSnr:
     def __call__(self, frame) -> None:
         self.push(frame.planes)
 
-    def push(self, planes) -> None:
+    def push(self, planes, lines=None) -> None:
+        """One frame; ``lines``: its region's column sums per plane where the caller has them (see
+        :func:`_luma`), so that a decode does not sum the same frame twice."""
         if self.roi is None:
             from wallcli.errors import WallcliError
             from wallcli.signal.blocks import check_roi
@@ -123,7 +133,7 @@ class ColumnSnr:
                 self.roi = False
         if self.roi is False:
             return
-        self._rows.append(_luma(planes, self.roi))
+        self._rows.append(_luma(planes, self.roi, lines))
         if len(self._rows) >= CHUNK:
             self._flush()
 
