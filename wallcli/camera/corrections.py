@@ -234,7 +234,7 @@ def correct_windows(parts: list[np.ndarray], offsets: list[np.ndarray], rate: fl
         balanced = balance(raws, rate, part) if options.exposure and raws[0].shape[1] >= MIN_SAMPLES else None
         found[w] += [balanced] if balanced is not None else []
         # colours summed: the nuisances are grey; (T, K) with K the bins of every part used
-        series = np.concatenate([r.sum(axis=-1).T for r in raws], axis=1)
+        series = np.concatenate([(r[..., 0] + r[..., 1] + r[..., 2]).T for r in raws], axis=1)  # as sum(-1), 10x faster
         vs = None
         if vertical_index is not None and vertical_index in used:
             start = sum(raws[i].shape[0] for i in range(used.index(vertical_index)))

@@ -29,11 +29,14 @@ def white_balance(raws: list[np.ndarray], rate: float, part: np.ndarray | None =
     share of the light, relative to its mean over the window), and the ``corrections`` finding
     (``{"kind": "white_balance", "amplitude": [r, g, b]}``); None where no colour moved."""
     raw = np.concatenate([np.asarray(r, np.float64) for r in raws], axis=0)  # (K, T, 3)
-    grey = raw.mean(axis=-1)
+    # the colours' mean as numpy's mean over the last axis sums them (ten times faster, same values)
+    grey = (raw[..., 0] + raw[..., 1] + raw[..., 2]) / 3.0
     ok = np.all(raw > 1e-6 * max(float(np.abs(raw).max()), 1e-12), axis=(1, 2)) & (grey.min(axis=1) > 0)
     if ok.sum() < 4:
         return None
-    share = np.log(raw[ok] / grey[ok][..., None])  # (K', T, 3)
+    if not ok.all():
+        raw, grey = raw[ok], grey[ok]
+    share = np.log(raw / grey[..., None])  # (K', T, 3)
     share -= share.mean(axis=1, keepdims=True)
     p = None if part is None else np.asarray(part)[ok]
     gains = np.zeros((raw.shape[1], 3))
