@@ -25,12 +25,15 @@ FPS = 30.0
 
 
 def _centred(w: np.ndarray) -> np.ndarray:
-    x = np.asarray(w, np.float64).mean(-1)  # (n, bins, T): the colours together
+    w = np.asarray(w, np.float64)
+    # the colours together (n, bins, T), summed as numpy's mean over the last axis sums them: the
+    # same values, ten times faster
+    x = (w[..., 0] + w[..., 1] + w[..., 2]) / 3.0 if w.shape[-1] == 3 else w.mean(-1)
     return x - x.mean(2, keepdims=True)
 
 
-def _plot(w: np.ndarray, off: np.ndarray) -> np.ndarray:
-    x = _centred(w)
+def _plot(w: np.ndarray, off: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Seven of a plot's features; ``x``: its :func:`_centred` form."""
     db = window_power_db([(w, off)])
     tot = (x ** 2).mean((1, 2)) + 1e-20
     g = x.mean(1)
@@ -64,8 +67,8 @@ def _top_patterns(x: np.ndarray) -> np.ndarray:
     return out
 
 
-def _vertical(h: np.ndarray, v: np.ndarray) -> np.ndarray:
-    xh, xv = _centred(h), _centred(v)
+def _vertical(xh: np.ndarray, xv: np.ndarray) -> np.ndarray:
+    """The five features of both plots together, of their :func:`_centred` forms."""
     pv = (xv ** 2).mean(2)
     half = xv.shape[1] // 2
     top = pv[:, :half].sum(1) / (pv.sum(1) + 1e-20)
@@ -84,4 +87,5 @@ def window_features(horizontal: np.ndarray, vertical: np.ndarray, h_offset: np.n
                     v_offset: np.ndarray) -> np.ndarray:
     """(n, len(NAMES)) float64 features of n windows (n, bins, window, 3) per plot, with the
     levels (..., bins, 3) they are relative to."""
-    return np.concatenate([_plot(horizontal, h_offset), _plot(vertical, v_offset), _vertical(horizontal, vertical)], 1)
+    xh, xv = _centred(horizontal), _centred(vertical)
+    return np.concatenate([_plot(horizontal, h_offset, xh), _plot(vertical, v_offset, xv), _vertical(xh, xv)], 1)
