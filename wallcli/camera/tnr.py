@@ -62,6 +62,7 @@ class TemporalNoise:
         self._d = None  # (2, tiles): sums of squared changes over 1 and 2 frames
         self.pairs = 0
         self._blocks = self._held = 0
+        self._flat = self._flat_for = None  # the tiles' offsets in a plane's memory, for its row spacing
 
     def __call__(self, frame) -> None:
         y = frame.planes.y
@@ -75,21 +76,38 @@ class TemporalNoise:
         if getattr(frame, "gap", 0.0):
             self._hist = []
         # every tile in one gather, in the plane's own integer codes: the differences and their
-        # squares are exact integers (summed in float64), a few numpy calls a frame
-        luma = y[self._at]
+        # squares are exact integers, summed as integers (the same sums), a few numpy calls a frame
+        luma = self._gather(y)
         z = luma[:, :, 2:].astype(np.int32) - luma[:, :, :-2]
         if self._hist:
             prev_luma, prev_z = self._hist[-1]
-            same = np.equal(luma[:, :, :TILE], prev_luma[:, :, :TILE]).reshape(len(z), TILE // 8, 8, TILE // 8, 8)
-            held = same.all(axis=(2, 4))
-            self._blocks += held.size
-            self._held += int(np.count_nonzero(held))
+            # 8x8 blocks with no sample changed: each block row's 8 comparisons read as one 64-bit word
+            changed = np.not_equal(luma[:, :, :TILE], prev_luma[:, :, :TILE]).view(np.uint64)
+            moved = np.count_nonzero(changed.reshape(len(z), TILE // 8, 8, TILE // 8).any(axis=2))
+            self._blocks += len(z) * (TILE // 8) ** 2
+            self._held += len(z) * (TILE // 8) ** 2 - int(moved)
             if len(self._hist) == 2:
+                wide = np.int32 if y.dtype == np.uint8 else np.int64  # (8 bits: 256 squares of 510 at most)
                 for k, before in ((0, prev_z), (1, self._hist[0][1])):
-                    dz = (z - before).astype(np.float64)
+                    dz = (z - before).astype(wide, copy=False)
                     self._d[k] += np.einsum("ijk,ijk->i", dz, dz)
                 self.pairs += 1
         self._hist = (self._hist + [(luma, z)])[-2:]
+
+    def _gather(self, y: np.ndarray) -> np.ndarray:
+        """The tiles' luma (tiles, TILE, TILE + 2): a take of precomputed offsets into the plane's
+        memory where its rows are evenly spaced (a decoder's plane), else an index of the plane."""
+        item = y.itemsize
+        if y.strides[1] != item or y.strides[0] % item or y.strides[0] < y.shape[1] * item:
+            return y[self._at]
+        if self._flat_for != y.strides[0]:
+            self._flat_for = y.strides[0]
+            self._flat = (self._at[0] * (y.strides[0] // item) + self._at[1]).astype(np.intp)
+        if y.flags.c_contiguous:
+            return np.take(y.reshape(-1), self._flat)
+        rows = y.strides[0] // item  # (a padded row: the plane's memory to its last sample, as one row)
+        flat = np.lib.stride_tricks.as_strided(y, shape=((y.shape[0] - 1) * rows + y.shape[1],), strides=(item,))
+        return np.take(flat, self._flat)
 
     def lag1(self) -> float | None:
         """The noise's lag-1 autocorrelation (median over the tiles), None before MIN_FRAMES or
