@@ -17,6 +17,7 @@ never differ (noise-free synthetic video) has no typical value and nothing is ev
 
 from __future__ import annotations
 
+import statistics
 from collections import deque
 from typing import Iterator
 
@@ -31,8 +32,10 @@ MAX_SAMPLES = 1 << 17  # luma pixels compared per frame (a lattice over larger f
 
 
 def _sample(y: np.ndarray) -> np.ndarray:
+    """The lattice, contiguous: its rows copied whole first (a memcpy each), then its columns
+    picked (0.07 ms at 1080p; picking both at once strides through the plane, 0.10 ms)."""
     step = max(1, int(np.ceil(np.sqrt(y.size / MAX_SAMPLES))))
-    return y[::step, ::step]
+    return np.ascontiguousarray(np.ascontiguousarray(y[::step])[:, ::step])
 
 
 class RepeatFilter:
@@ -62,7 +65,7 @@ class RepeatFilter:
 
         # one contiguous copy of the lattice, compared by OpenCV (exact: an integer L1 sum in a
         # double), outside the GIL and a fortieth of numpy's int32 round trip
-        cur = np.ascontiguousarray(_sample(y))
+        cur = _sample(y)
         prev, self._prev = self._prev, cur
         if prev is None or prev.shape != cur.shape or prev.dtype != cur.dtype:
             return None
@@ -73,7 +76,8 @@ class RepeatFilter:
     def _judge(self, d: float | None) -> bool:
         if d is None:
             return False
-        if len(self._recent) >= MIN_HISTORY and d < REL * float(np.median(self._recent)):
+        # (np.median's value, without its overhead on 16 floats)
+        if len(self._recent) >= MIN_HISTORY and d < REL * statistics.median(self._recent):
             return True
         if d > 0:
             self._recent.append(d)
