@@ -121,13 +121,14 @@ def frame_planes(frame) -> Planes:
         r, gg, b = (arr[..., 0], arr[..., 1], arr[..., 2]) if name == "rgb24" else (arr[..., 2], arr[..., 1], arr[..., 0])
         return Planes(np.ascontiguousarray(r), np.ascontiguousarray(gg), np.ascontiguousarray(b), kind="rgb")
     if name == "gbrp":
-        gp, bp, rp = (_plane_array(frame.planes[i], w, h, np.uint8) for i in range(3))
+        gp, bp, rp = (_plane_array(p, w, h, np.uint8) for p in frame.planes[:3])
         return Planes(rp, gp, bp, kind="rgb")
     bits = int((m or g).group(3 if m else 1) or 8)
     if (m or g).group(4 if m else 2) == "be":
         frame = frame.reformat(format=name[:-2] + "le")
     dtype = np.uint8 if bits <= 8 else np.uint16
-    y = _plane_array(frame.planes[0], w, h, dtype)
+    planes = frame.planes  # (PyAV builds the list anew at each access: 9 us)
+    y = _plane_array(planes[0], w, h, dtype)
     spc = _AVCOL_SPC.get(int(frame.colorspace or 2)) or ("bt709" if h >= 720 else "bt601")
     full = int(frame.color_range or 0) == 2 or (m is not None and m.group(1) == "j")
     if g is not None:
@@ -135,8 +136,8 @@ def frame_planes(frame) -> Planes:
         return Planes(y, None, None, kind="gray", depth=bits, matrix=spc, full_range=int(frame.color_range or 0) != 1)
     sx, sy = _SUB[m.group(2)]
     cw, ch = (w + (1 << sx) - 1) >> sx, (h + (1 << sy) - 1) >> sy  # ceil: odd sizes keep their last column
-    u = _plane_array(frame.planes[1], cw, ch, dtype)
-    v = _plane_array(frame.planes[2], cw, ch, dtype)
+    u = _plane_array(planes[1], cw, ch, dtype)
+    v = _plane_array(planes[2], cw, ch, dtype)
     return Planes(y, u, v, kind="yuv", sub_x=sx, sub_y=sy, depth=bits, matrix=spc, full_range=full)
 
 
