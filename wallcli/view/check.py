@@ -15,13 +15,14 @@ the sub-pixel shake a tripod on a floor has, which corrections (not refusal) dea
 """
 from __future__ import annotations
 
+import statistics
 from collections import deque
 
 import numpy as np
 
 from wallcli.view.cut import CutWatch
 from wallcli.view.image import (
-    _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _pixels, _robust_sigma, _upper_median, _whole_blocks,
+    _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _inner_difference, _pixels, _robust_sigma, _upper_median, _whole_blocks,
 )
 from wallcli.view.light import _chroma, _objects, _relative_texture
 from wallcli.view.limits import (
@@ -55,7 +56,7 @@ class ViewCheck:
         self.min_usable = 1.0
         self._sig_b: deque = deque(maxlen=HISTORY)
         self._sig_h: deque = deque(maxlen=HISTORY)
-        self._prev_b = self._prev_h = self._ref_h = self._bg_h = self._bg_b = None
+        self._prev_b = self._prev_h = self._ref_h = self._ref_w = self._bg_h = self._bg_b = None
         self._bg_n = 0  # frames averaged into the background since the last reset
         self._t_prev = None
         self._t_checked = -np.inf
@@ -137,20 +138,28 @@ class ViewCheck:
                 self.frames += 1
                 self._mark("too small to check", t)
             return
+        due = self._cut.due(t)
+        if not due and self._idle(t):
+            return  # most frames of a calm view: nothing is read of them
         # these images are too small for OpenCV's pool's hand-offs to pay (blocks.one_opencv_thread)
         with one_opencv_thread():
             cut = None
-            if self._cut.due(t):
+            if due:
                 cut, busy = self._cut(t, planes, self.roi)
                 if busy:
                     self._dense_until = t + DENSE
             if cut is not None:
                 self._mark("scene cut", cut)
                 self._cut_reset = True
-            if t - self._t_checked < 1.0 / CHECK_RATE - 1e-3 and t > self._dense_until and not self._cut_reset:
+            if self._idle(t):
                 return
             self._t_checked = t
             self._update(t, planes)
+
+    def _idle(self, t: float) -> bool:
+        """Whether the frame at ``t`` goes unchecked: one was checked less than 1/CHECK_RATE s
+        before, and nothing suspect (nor a cut) was seen since."""
+        return t - self._t_checked < 1.0 / CHECK_RATE - 1e-3 and t > self._dense_until and not self._cut_reset
 
     def _update(self, t: float, planes) -> None:
         import cv2
@@ -219,6 +228,7 @@ class ViewCheck:
     def _reset(self, hp, small, blocks, planes, full) -> None:
         self._dense_until = max(self._dense_until, self._t_checked + DENSE)  # neighbours' noise first
         self._ref_h, self._bg_h, self._bg_b = hp, _highpass(small, FINE), blocks.copy()
+        self._ref_w = None  # the reference windowed for the phase correlation
         self._tex = _relative_texture(small, self._bg_h)
         self._ref_rel = _in_band(hp, small, self._bg_h, self._tex)
         self._ref_fine = self._tex
@@ -235,18 +245,17 @@ class ViewCheck:
         if not ok.any():
             return flags
         suspect = False
-        prev = self._prev_b
-        d = blocks - prev
         # the noise is measured between neighbouring frames only: between checks a fifth of a
         # second apart a shake or a shadow has moved the picture too, and the thresholds built
         # on such a 'noise' let exactly those through
         gap = t - self._t_prev
         self._gap = min(self._gap, gap)
         if gap <= 1.5 * self._gap or not self._sig_b:
-            self._sig_b.append(_robust_sigma(d[ok]))
-            self._sig_h.append(_robust_sigma((hp - self._prev_h)[4:-4, 4:-4]) ** 2 if min(hp.shape) > 8 else 0.0)
-        sigma = max(float(np.median(self._sig_b)), SIGMA_FLOOR)
-        var_h = max(float(np.median(self._sig_h)), SIGMA_FLOOR ** 2)
+            self._sig_b.append(_robust_sigma((blocks - self._prev_b)[ok]))
+            self._sig_h.append(_robust_sigma(_inner_difference(hp, self._prev_h, 4)) ** 2 if min(hp.shape) > 8 else 0.0)
+        # statistics' median of these Python floats is numpy's to the bit, at a tenth of the cost
+        sigma = max(statistics.median(self._sig_b), SIGMA_FLOOR)
+        var_h = max(statistics.median(self._sig_h), SIGMA_FLOOR ** 2)
         level = np.maximum(blocks, DARK)
         # camera motion: a shift of the frame's fine structure against the reference frame that
         # explains more of the change than the noise could
@@ -262,8 +271,12 @@ class ViewCheck:
         else:
             if self._window is None or self._window.shape != hp.shape:
                 self._window = cv2.createHanningWindow(hp.shape[::-1], cv2.CV_32F)
-            # copies: OpenCV applies the window to its inputs in place
-            (dx, dy), _ = cv2.phaseCorrelate(self._ref_h.copy(), hp.copy(), self._window)
+                self._ref_w = None
+            # windowed here (OpenCV's own product, to the bit), the reference once until the next
+            # reset: OpenCV would window copies of both on every check
+            if self._ref_w is None:
+                self._ref_w = self._ref_h * self._window
+            (dx, dy), _ = cv2.phaseCorrelate(self._ref_w, hp * self._window)
         shift = float(np.hypot(dx, dy)) * self._scale
         moved = False
         # a shift of half the floor that fits is not motion yet, but a shake on its way to it:
@@ -298,16 +311,21 @@ class ViewCheck:
         # first is often the codec's intra frame, coded unlike the rest) is not the wall's
         self._bg_n += 1
         a = max(a, 1.0 / self._bg_n)
-        # light falling on the wall scales its texture with it: compare with the background's
-        # texture scaled by each block's change of level, so a shadow's dimming is not an outline
-        scale = cv2.resize(blocks / np.maximum(g * self._bg_b, 1.0), fine.shape[::-1], interpolation=cv2.INTER_LINEAR)
-        energy = cv2.resize((fine - scale * self._bg_h) ** 2, blocks.shape[::-1], interpolation=cv2.INTER_AREA)
-        edge = np.sqrt(energy)
-        step = cv2.dilate(np.where(ok, dev, 0.0).astype(np.float32), np.ones((3, 3), np.uint8))
-        n = max(_block_side(small.shape) ** 2 / 4.0, 1.0)
-        noise = _upper_median(edge[ok]) * (1.0 + K_EDGE / np.sqrt(2.0 * n))
-        floor = np.maximum(REL_EDGE * np.maximum(blocks, EDGE_LEVEL), noise)
-        hit = broad & (edge > floor) & (edge > SHARP * step) & ok
+        changed = broad & ok
+        anything = bool(changed.any())
+        if anything:
+            # light falling on the wall scales its texture with it: compare with the background's
+            # texture scaled by each block's change of level, so a shadow's dimming is not an outline
+            scale = cv2.resize(blocks / np.maximum(g * self._bg_b, 1.0), fine.shape[::-1], interpolation=cv2.INTER_LINEAR)
+            energy = cv2.resize((fine - scale * self._bg_h) ** 2, blocks.shape[::-1], interpolation=cv2.INTER_AREA)
+            edge = np.sqrt(energy)
+            step = cv2.dilate(np.where(ok, dev, 0.0).astype(np.float32), np.ones((3, 3), np.uint8))
+            n = max(_block_side(small.shape) ** 2 / 4.0, 1.0)
+            noise = _upper_median(edge[ok]) * (1.0 + K_EDGE / np.sqrt(2.0 * n))
+            floor = np.maximum(REL_EDGE * np.maximum(blocks, EDGE_LEVEL), noise)
+            hit = changed & (edge > floor) & (edge > SHARP * step)
+        else:  # no block changed (a calm view, most checks): no outline to look for
+            hit = changed
         # a bright object saturates: blocks clipped now whose background was well inside the usable
         # range (a rise of over 2 x REL, no hidden person's) are blocks something covered; the
         # rules above never see them, as clipped blocks are not 'ok'
@@ -318,7 +336,7 @@ class ViewCheck:
         # check's cost on a wall with moving shadows)
         learn_due = t - self._t_tex >= 1.0 / MATCH_RATE - 1e-3
         history_due = t - self._t_match >= 1.0 / MATCH_RATE - 1e-3
-        outlined = not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS
+        outlined = anything and not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS
         rel = _relative_texture(small, fine) if moved or outlined or learn_due or history_due else None
         if moved or history_due:
             still = _pixels(ok & ~broad, rel.shape)
@@ -347,9 +365,9 @@ class ViewCheck:
         # inside it, on the wall's texture relative to its level (which light does not change)
         chroma = _chroma(planes, self.roi, blocks, full) if self._bg_c is not None and (outlined or learn_due) else None
         judged = hit
-        if not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:
+        if anything and not moved and int(hit.sum()) >= MIN_MOVER_BLOCKS:  # outlined, or a shift taken back
             ratio = blocks / np.maximum(g * self._bg_b, 1e-3)
-            judged, light = _objects(t, hit, broad & ok, ok, rel, ratio, chroma, self._tex, self._bg_b, self._bg_c,
+            judged, light = _objects(t, hit, changed, ok, rel, ratio, chroma, self._tex, self._bg_b, self._bg_c,
                                      self.trace)
             if light:
                 self._mark_note("sharp light", t)
@@ -362,9 +380,13 @@ class ViewCheck:
                 if len(self._object_hits) > MAX_OBJECT_HITS:  # memory stays flat: no taking back from now on
                     self._object_hits = None
         # every frame for a while after anything suspect; a sharp change of light is not
-        if suspect or moved or judged.any() or ((broad & ok).any() and not outlined):
+        if suspect or moved or judged.any() or (anything and not outlined):
             self._dense_until = t + DENSE
-        self._bg_h = ((1 - a) * self._bg_h + a * fine).astype(np.float32)
+        # in place where that is the same arithmetic (a may be numpy's float64, and then so is
+        # the blend, rounded once at the end as before): a full-size temporary less each
+        bg_h = self._bg_h * (1 - a)
+        bg_h += a * fine
+        self._bg_h = bg_h.astype(np.float32, copy=False)
         self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
         # the wall's texture: learnt where nothing changed, slower than the background (a shadow
         # that stays is learnt through, an object that stops is learnt like the background)
@@ -375,7 +397,12 @@ class ViewCheck:
         self._t_tex = t
         tex = self._tex
         learn = calm & np.isfinite(rel)  # an unknown pixel (an edge) keeps what was learnt
-        self._tex = np.where(learn, np.where(np.isfinite(tex), (1 - b) * tex + b * rel, rel), tex).astype(np.float32)
+        # the blend rounded to float32 before it is picked, not after: the same values, and the
+        # picking is on float32 (b may be numpy's float64, and then so is the blend)
+        blend = tex * (1 - b)
+        blend += b * rel
+        blend = blend.astype(np.float32, copy=False)
+        self._tex = np.where(learn, np.where(np.isfinite(tex), blend, rel), tex)
         if chroma is not None:
             keep = ~broad & ok
             self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c).astype(np.float32)

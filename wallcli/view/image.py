@@ -90,9 +90,11 @@ def _sampled_luma(planes, roi, max_side: int) -> np.ndarray:
     if planes.kind == "rgb":
         g, b = sample(_crop(planes.u, roi)), sample(_crop(planes.v, roi))
         return (np.float32(0.299) * y + np.float32(0.587) * g + np.float32(0.114) * b) / scale
-    y /= scale
-    if not planes.full_range:
-        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
+    if scale != 1:  # a division by 1 is the identity, to the bit
+        y /= scale
+    if not planes.full_range:  # in place: y is this function's own copy
+        y -= np.float32(16.0)
+        y *= np.float32(255.0 / 219.0)
     return y
 
 
@@ -110,9 +112,12 @@ def _grey(planes, roi, max_side: int) -> tuple[np.ndarray, int]:
     if planes.kind == "rgb":
         y = (0.299 * _shrink(Y, size) + 0.587 * _shrink(crop(planes.u), size) + 0.114 * _shrink(crop(planes.v), size)) / scale
         return y.astype(np.float32), w
-    y = _shrink(Y, size) / np.float32(scale)
+    y = _shrink(Y, size)  # a new array: what follows is done in place
+    if scale != 1:  # a division by 1 is the identity, to the bit
+        y /= np.float32(scale)
     if not planes.full_range:
-        y = (y - np.float32(16.0)) * np.float32(255.0 / 219.0)
+        y -= np.float32(16.0)
+        y *= np.float32(255.0 / 219.0)
     return y, w
 
 
@@ -193,3 +198,21 @@ def _pixels(mask: np.ndarray, shape) -> np.ndarray:
     import cv2
 
     return cv2.resize(mask.astype(np.uint8), shape[::-1], interpolation=cv2.INTER_NEAREST).astype(bool)
+
+
+_INNER: dict = {}
+
+
+def _inner_difference(a: np.ndarray, b: np.ndarray, margin: int) -> np.ndarray:
+    """``(a - b)[margin:-margin, margin:-margin]`` as far as :func:`_robust_sigma` reads it: over
+    4096 values it reads a fixed stride of them, which are then all that is subtracted (the
+    gather's indices kept per shape: the whole difference and its copy were most of the cost)."""
+    h, w = a.shape[0] - 2 * margin, a.shape[1] - 2 * margin
+    if h * w <= 4096:
+        return (a - b)[margin:-margin, margin:-margin]
+    key = (a.shape, margin)
+    if key not in _INNER:
+        flat = np.arange(0, h * w, (h * w) // 2048)
+        _INNER[key] = (flat // w + margin, flat % w + margin)
+    rows, cols = _INNER[key]
+    return a[rows, cols] - b[rows, cols]

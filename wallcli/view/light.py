@@ -40,9 +40,12 @@ def _chroma(planes, roi, blocks, full) -> np.ndarray | None:
     scale = np.float32(1 << (planes.depth - 8))
     out = []
     for a in (planes.u, planes.v):
-        c = _whole_blocks(_shrink(_crop(a, roi), full[::-1]) / scale)
+        c = _shrink(_crop(a, roi), full[::-1])  # a new array: what follows is done in place
+        if scale != 1:  # a division by 1 is the identity, to the bit
+            c /= scale
+        c = _whole_blocks(c)
         if planes.kind != "rgb":
-            c = c - np.float32(128.0)
+            c -= np.float32(128.0)
         out.append(cv2.resize(c, blocks.shape[::-1], interpolation=cv2.INTER_AREA))
     return np.stack(out) / np.maximum(blocks, DARK)
 
