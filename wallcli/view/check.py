@@ -22,7 +22,7 @@ import numpy as np
 
 from wallcli.view.cut import CutWatch
 from wallcli.view.image import (
-    _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _inner_difference, _pixels, _robust_sigma, _upper_median, _whole_blocks,
+    _block_rects, _block_side, _box_blocks, _broad_blur, _cells, _grey, _highpass, _inner_difference, _median, _pixels, _robust_sigma, _upper_median, _whole_blocks,
 )
 from wallcli.view.light import _chroma, _objects, _relative_texture
 from wallcli.view.limits import (
@@ -183,7 +183,7 @@ class ViewCheck:
             ok, clipped, dark = ok & ~hidden, clipped & ~hidden, dark & ~hidden
             usable = float(ok.sum()) / float((~hidden).sum())
         else:
-            usable = float(ok.mean())
+            usable = np.count_nonzero(ok) / ok.size  # ok.mean(), to the bit
         self.min_usable = min(self.min_usable, usable)
         flags = set()
         if usable < MIN_USABLE:
@@ -298,7 +298,7 @@ class ViewCheck:
         # the wall's own texture, relative to its level, where nothing changed: still in its
         # place (the learnt texture at no shift) if the camera did not move, whatever light did
         a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
-        g = float(np.median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3)))
+        g = _median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3))
         dev = np.abs(blocks - g * self._bg_b)
         broad = dev > np.maximum(K_MOVER * sigma, REL * level)
         fine = _highpass(small, FINE)

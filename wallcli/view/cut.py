@@ -8,11 +8,14 @@ from collections import deque
 
 import numpy as np
 
-from wallcli.view.image import _block_side, _robust_sigma, _sampled_luma, _upper_median, _whole_blocks
+from wallcli.view.image import _block_side, _robust_sigma, _sampled_luma, _upper_median, _whole_block_bounds
 from wallcli.view.limits import (
     CLIP_HI, CUT_CALM, CUT_CELLS, CUT_FRACTION, CUT_RATE, CUT_REACH, CUT_SIDE, CUT_SPIKE, DARK, HISTORY, K_CUT,
     MIN_USABLE, REL_CUT, SIGMA_FLOOR,
 )
+
+
+_SQRT2 = np.sqrt(2.0)  # numpy's float64: the threshold below is float64, as it always was
 
 
 class CutWatch:
@@ -24,6 +27,7 @@ class CutWatch:
         self._prev = None
         self._fracs = (1.0, 1.0)  # changed shares of the last two frames (none calm before the first)
         self._sig: deque = deque(maxlen=HISTORY)
+        self._grid = None  # (sample shape, rows and columns whole blocks tile, block grid size)
         # the coarse gain-free steps (time of the later sample, RMS): the clip's, and the last few
         self._steps: deque = deque(maxlen=HISTORY + CUT_REACH + 1)
 
@@ -41,9 +45,13 @@ class CutWatch:
         anything suspect, that every frame be checked for a while."""
         import cv2
 
-        y = _whole_blocks(_sampled_luma(planes, roi, CUT_SIDE))
-        bh, bw = (n // _block_side(y.shape) for n in y.shape)
-        blocks = cv2.resize(y, (bw, bh), interpolation=cv2.INTER_AREA)
+        y = _sampled_luma(planes, roi, CUT_SIDE)
+        if self._grid is None or self._grid[0] != y.shape:  # the block grid, kept while the size is
+            rows, cols = _whole_block_bounds(y.shape)
+            side = _block_side((rows.stop - rows.start, cols.stop - cols.start))
+            self._grid = (y.shape, rows, cols, ((cols.stop - cols.start) // side, (rows.stop - rows.start) // side))
+        _, rows, cols, size = self._grid
+        blocks = cv2.resize(y[rows, cols], size, interpolation=cv2.INTER_AREA)
         prev, t_prev = self._prev, self.t
         self._prev, self.t = blocks, t
         if prev is None or prev.shape != blocks.shape:
@@ -56,7 +64,7 @@ class CutWatch:
         self._sig.append(_robust_sigma(b - p))
         sigma = max(statistics.median(self._sig), SIGMA_FLOOR)
         gain = _upper_median(b / p)  # p >= DARK > 0
-        threshold = np.maximum(b * REL_CUT, K_CUT * sigma * np.sqrt(2.0))
+        threshold = np.maximum(b * REL_CUT, K_CUT * sigma * _SQRT2)
         frac = np.count_nonzero(np.abs(b - gain * p) > threshold) / b.size
         before = self._fracs
         self._fracs = (before[1], frac)
@@ -73,8 +81,8 @@ class CutWatch:
         k = max(1, max(blocks.shape) // CUT_CELLS)
         hh, ww = blocks.shape[0] // k * k, blocks.shape[1] // k * k
         step = np.nan
-        if hh and ww and ok.mean() >= MIN_USABLE:
-            r = np.where(ok, (blocks - gain * prev) / np.maximum(prev, DARK), 0.0).astype(np.float32)
+        if hh and ww and np.count_nonzero(ok) / ok.size >= MIN_USABLE:
+            r = np.where(ok, (blocks - gain * prev) / np.maximum(prev, DARK), np.float32(0.0))
             size = (ww // k, hh // k)
             cells = cv2.resize(r[:hh, :ww], size, interpolation=cv2.INTER_AREA)
             share = cv2.resize(ok[:hh, :ww].astype(np.float32), size, interpolation=cv2.INTER_AREA)
@@ -86,10 +94,10 @@ class CutWatch:
         n = 2 * CUT_REACH + 1
         if len(steps) < n + 3:  # a median of at least 3 earlier steps
             return None
-        recent = [s for _, s in list(steps)[-n:]]
         t_mid, mid = steps[-CUT_REACH - 1]
         if not mid > REL_CUT / 2:  # nan (too little usable) too
             return None
+        recent = [s for _, s in list(steps)[-n:]]
         others = [s for i, s in enumerate(recent) if i != CUT_REACH and s == s]
         earlier = [s for _, s in list(steps)[:-n + CUT_REACH] if s == s]
         if len(earlier) < 3 or (others and mid <= CUT_SPIKE * max(others)):
