@@ -100,3 +100,13 @@ def test_column_snr_fed_by_the_rows_is_the_taps(tmp_path):
     assert n > 0 and fed.samples == tap.samples
     assert fed.db() == tap.db() is not None
 
+
+@pytest.mark.parametrize("W", [4, 63, 64, 480, 512])
+def test_chunk_components_are_the_dct_product(W):
+    rng = np.random.default_rng(W)
+    g = rng.normal(size=(256, W)) * 3.0
+    g -= g.mean(axis=0, keepdims=True)
+    want = g @ column._dct(W)[1:].T
+    got = column._components(g)
+    assert got.shape == want.shape
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
