@@ -52,8 +52,9 @@ PAD = 2  # samples: a step's box widened by this before the pairs either side ar
 MAX_BOX = 0.08  # of the frame's area: an overlay's step (some digits), or a line of text, is no larger
 STILL_RUN = 0.5  # seconds over which a static text's samples have hardly changed
 STATIC_EVERY = 1.0  # seconds between looks for still text: it stays where it is, and a look costs
-# a median over a wide neighbourhood of the whole frame (3-6 ms at 640 samples; at 8 frames apart it
-# was a third of the overlay check's time on a 1080p export, bench/RESULTS.md)
+# a median over a wide neighbourhood of each still sample (about 1 ms at 640 samples where they are
+# a few dozen, 3-6 ms over the whole frame where many; at 8 frames apart it was a third of the
+# overlay check's time on a 1080p export, bench/RESULTS.md)
 STILL_REL = 0.2  # hardly: by under this share of the frame's typical change (and 0.05 codes: not at all)
 STATIC_CONTRAST = 24.0  # 8-bit codes from their neighbourhood's median (a codec leaves wall texture still too)
 STATIC_PIXELS = 10  # such samples in a line of text
