@@ -22,6 +22,7 @@ Decisions (the paper is silent on them):
 from __future__ import annotations
 
 from collections import deque
+from functools import lru_cache
 from typing import Iterator
 
 import numpy as np
@@ -201,10 +202,22 @@ SLOW_HZ = (0.3, 2.5)
 _MEDIAN_CHI2_6 = 0.8907
 
 
+@lru_cache(maxsize=8)
 def _dct_rows(n: int) -> np.ndarray:
     k = np.arange(n)[:, None]
     b = np.cos(np.pi * (np.arange(n)[None] + 0.5) * k / n)
-    return b / np.linalg.norm(b, axis=1, keepdims=True)
+    b = b / np.linalg.norm(b, axis=1, keepdims=True)
+    b.setflags(write=False)  # shared by every window of a run
+    return b
+
+
+@lru_cache(maxsize=8)
+def _taper(T: int) -> tuple[np.ndarray, float]:
+    """The Hann taper of a window of ``T`` samples (as a (T, 1) column) and its power sum."""
+    taper = np.hanning(T)
+    col = taper[:, None].copy()
+    col.setflags(write=False)
+    return col, float(np.sum(taper * taper))
 
 
 def _coarse(bins: int) -> int:
@@ -217,34 +230,45 @@ def _spectrum(y: np.ndarray) -> np.ndarray:
     spatial component but the mean (a DCT across the bins) at each temporal frequency, per sample
     (tapered; the colours averaged)."""
     bins, T = y.shape[-3], y.shape[-2]
-    # component 0 (the wall's mean) is gone; einsum, not a matrix product: BLAS's threads would spin
-    # on the cores the decoder is using (0.6 CPU s more on a 30 s 1080p count)
-    z = np.einsum("kb,...btc->...ktc", _dct_rows(bins)[1:], y)
-    taper = np.hanning(T)
-    spec = np.fft.rfft(z * taper[:, None], axis=-2)
-    return np.mean(spec.real ** 2 + spec.imag ** 2, axis=-1) / np.sum(taper * taper)
+    # component 0 (the wall's mean) is gone; a matrix product over (bins, T*3) (einsum took 4x as
+    # long; the CLI holds BLAS to one thread, so none spins on the decoder's cores)
+    lead = y.shape[:-3]
+    z = np.matmul(_dct_rows(bins)[1:], np.ascontiguousarray(y).reshape(*lead, bins, T * 3))
+    z = z.reshape(*lead, bins - 1, T, 3)
+    taper, taper_power = _taper(T)
+    spec = np.fft.rfft(z * taper, axis=-2)
+    return np.mean(spec.real ** 2 + spec.imag ** 2, axis=-1) / taper_power
 
 
-def _coherent(power: np.ndarray, bins: int) -> np.ndarray:
+def _fine_level(power: np.ndarray, bins: int) -> np.ndarray:
+    """The fine components' level at each frequency of a :func:`_spectrum` (..., F): their median
+    over components, for chi-square's median (read by :func:`_coherent` and :func:`_colour`)."""
+    return np.median(power[..., _coarse(bins) - 1:, :], axis=-2) / _MEDIAN_CHI2_6
+
+
+def _coherent(power: np.ndarray, bins: int, white: np.ndarray | None = None) -> np.ndarray:
     """The power of the windows' spatially coherent change, per sample and bin, from their
     :func:`_spectrum`: the coarse components' power at each frequency less the level the fine
-    components show at it (their median over components, for chi-square's median)."""
+    components show at it (:func:`_fine_level`, or ``white`` where already read)."""
     coarse = _coarse(bins)
-    white = np.median(power[..., coarse - 1:, :], axis=-2) / _MEDIAN_CHI2_6  # (..., F)
+    if white is None:
+        white = _fine_level(power, bins)  # (..., F)
     return np.sum(np.mean(power[..., :coarse - 1, :] - white[..., None, :], axis=-1), axis=-1) / bins
 
 
-def _colour(power: np.ndarray, bins: int, T: int, step: np.ndarray, fps: float) -> np.ndarray | None:
+def _colour(power: np.ndarray, bins: int, T: int, step: np.ndarray, fps: float,
+            white: np.ndarray | None = None) -> np.ndarray | None:
     """How much more noise the windows hold at a person's frequencies (SLOW_HZ) than their
     frame-to-frame figure ``step`` says (1: white), read where a person's light is not: the fine
-    spatial components' level in their :func:`_spectrum` (the median over components at each
-    frequency, for chi-square's median); None where the window has no such frequency."""
+    spatial components' level in their :func:`_spectrum` (:func:`_fine_level`, or ``white`` where
+    already read); None where the window has no such frequency."""
     f = np.fft.rfftfreq(T, 1.0 / fps)
     slow = (f >= SLOW_HZ[0]) & (f <= SLOW_HZ[1])
     if not slow.any():
         return None
-    coarse = _coarse(bins)
-    low = np.mean(np.median(power[..., coarse - 1:, :][..., slow], axis=-2), axis=-1) / _MEDIAN_CHI2_6
+    if white is None:
+        white = _fine_level(power, bins)
+    low = np.mean(white[..., slow], axis=-1)
     return low / np.maximum(step, 1e-30)
 
 
@@ -282,12 +306,13 @@ def window_signal_db(parts: list[tuple[np.ndarray, np.ndarray]], fps: float = CA
         n = 0.5 * np.mean(np.square(np.diff(y, axis=-2)), axis=(-3, -2, -1))
         if y.shape[-3] >= MIN_BINS and y.shape[-2] >= 8:
             power = _spectrum(y)
-            s = _coherent(power, y.shape[-3])
+            white = _fine_level(power, y.shape[-3])  # one median for both reads
+            s = _coherent(power, y.shape[-3], white)
             if i == 0:
                 # the noise's colour is the camera's; it is read on the first plot (the horizontal
                 # one: a column averages the wall's rows, so a masked line of text, which fills
                 # whole rows of the vertical plot, is a small part of each)
-                colour = _colour(power, y.shape[-3], y.shape[-2], n, fps)
+                colour = _colour(power, y.shape[-3], y.shape[-2], n, fps, white)
         else:
             s = np.mean(np.square(y), axis=(-3, -2, -1)) - n
         signal, noise = signal + s, noise + n
