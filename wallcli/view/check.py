@@ -15,6 +15,7 @@ the sub-pixel shake a tripod on a floor has, which corrections (not refusal) dea
 """
 from __future__ import annotations
 
+import math
 import statistics
 from collections import deque
 
@@ -297,7 +298,9 @@ class ViewCheck:
             self._shifts.append((np.inf, np.inf))
         # the wall's own texture, relative to its level, where nothing changed: still in its
         # place (the learnt texture at no shift) if the camera did not move, whatever light did
-        a = 1.0 - np.exp(-max(t - self._t_prev, 1e-3) / 2.0)  # 2 s: a mover that stops fades out
+        # Python floats, not numpy's float64: the blends below then stay float32 (a float64 scalar
+        # made each a float64 image and a rounding copy)
+        a = 1.0 - math.exp(-max(float(t - self._t_prev), 1e-3) / 2.0)  # 2 s: a mover that stops fades out
         g = _median(blocks[ok] / np.maximum(self._bg_b[ok], 1e-3))
         dev = np.abs(blocks - g * self._bg_b)
         broad = dev > np.maximum(K_MOVER * sigma, REL * level)
@@ -382,30 +385,26 @@ class ViewCheck:
         # every frame for a while after anything suspect; a sharp change of light is not
         if suspect or moved or judged.any() or (anything and not outlined):
             self._dense_until = t + DENSE
-        # in place where that is the same arithmetic (a may be numpy's float64, and then so is
-        # the blend, rounded once at the end as before): a full-size temporary less each
+        # in place, in float32 (a is a Python float): a full-size temporary less each
         bg_h = self._bg_h * (1 - a)
         bg_h += a * fine
-        self._bg_h = bg_h.astype(np.float32, copy=False)
-        self._bg_b = ((1 - a) * self._bg_b + a * blocks / max(g, 1e-3)).astype(np.float32)
+        self._bg_h = bg_h
+        self._bg_b = (1 - a) * self._bg_b + a * blocks / max(g, 1e-3)
         # the wall's texture: learnt where nothing changed, slower than the background (a shadow
         # that stays is learnt through, an object that stops is learnt like the background)
         if not learn_due:
             return flags
         calm = _pixels(~broad & ok, rel.shape)
-        b = max(1.0 - np.exp(-max(t - self._t_tex, 1e-3) / TEX_TAU), 1.0 / self._bg_n)
+        b = max(1.0 - math.exp(-max(float(t - self._t_tex), 1e-3) / TEX_TAU), 1.0 / self._bg_n)
         self._t_tex = t
         tex = self._tex
         learn = calm & np.isfinite(rel)  # an unknown pixel (an edge) keeps what was learnt
-        # the blend rounded to float32 before it is picked, not after: the same values, and the
-        # picking is on float32 (b may be numpy's float64, and then so is the blend)
-        blend = tex * (1 - b)
+        blend = tex * (1 - b)  # float32: b is a Python float
         blend += b * rel
-        blend = blend.astype(np.float32, copy=False)
         self._tex = np.where(learn, np.where(np.isfinite(tex), blend, rel), tex)
         if chroma is not None:
             keep = ~broad & ok
-            self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c).astype(np.float32)
+            self._bg_c = np.where(keep, (1 - b) * self._bg_c + b * chroma, self._bg_c)
         return flags
 
 
