@@ -49,49 +49,69 @@ class InterlaceFilter:
         self.since: float | None = None  # time of the first frame corrected
         self.progressive = False  # shown progressive: nothing more is read
         self._fps = 30.0
-        self._seen: deque = deque(maxlen=5)  # (top field at the bottom rows, bottom field) of the last frames
-        self._mean = None  # running means of the ratio and the rate
+        self._seen: deque = deque(maxlen=5)  # the last frames' _fields
+        self._mean = None  # running means of the ratio and the rates, both sides: (3, 2, groups, columns)
+        self._rows = None  # (plane height, the rows read, groups of four)
         self._n = 0
         self._sums = np.zeros((2, 6))  # per side: sum xy, xx, yy, the samples, zy and zx, over the frames
 
     def __getattr__(self, name: str):
         return getattr(self.reader, name)
 
-    def _fields(self, y: np.ndarray):
-        """(top field at the bottom rows, bottom field; bottom field at the top rows, top field)."""
+    def _fields(self, y: np.ndarray) -> np.ndarray:
+        """(4, groups, columns): the top field at the bottom rows, the bottom field, the bottom field
+        at the top rows, the top field; sides 0 and 1 at [0::2] (the references) and [1::2] (what is
+        read against them), so each step of :meth:`_observe` is one numpy call for both sides."""
         step = max(1, -(-y.shape[1] // MAX_COLUMNS))
-        n = min((y.shape[0] - 1) // 2, y.shape[0] // 2 - 1)
-        i = np.arange(0, n, max(1, -(-n // MAX_PAIRS)))  # groups of rows 2i..2i+3 (every row of them read)
-        # one gather of the four rows of every group (lattice columns), one conversion
-        g = y[(2 * i[:, None] + np.arange(4)).ravel(), ::step].astype(np.float32).reshape(len(i), 4, -1)
-        top, bottom, top1, bottom1 = g[:, 0], g[:, 1], g[:, 2], g[:, 3]
-        return np.maximum(0.5 * (top + top1), 1.0), bottom, np.maximum(0.5 * (bottom + bottom1), 1.0), top1
+        if self._rows is None or self._rows[0] != y.shape[0]:
+            n = min((y.shape[0] - 1) // 2, y.shape[0] // 2 - 1)
+            i = np.arange(0, n, max(1, -(-n // MAX_PAIRS)))  # groups of rows 2i..2i+3 (every row of them read)
+            # rows 2i, 2i+1, 2i+3, 2i+2 (top, bottom, bottom1, top1) of every group, each kind's together
+            self._rows = (y.shape[0], (2 * i[None, :] + np.array([0, 1, 3, 2])[:, None]).ravel(), len(i))
+        _, rows, groups = self._rows
+        f = y[rows, ::step].astype(np.float32).reshape(4, groups, -1)  # one gather, one conversion
+        ref = f[0::2] + f[3::-2]  # top + top1, bottom1 + bottom
+        ref *= 0.5
+        np.maximum(ref, 1.0, out=f[0::2])
+        return f
 
     def _observe(self, y: np.ndarray, fps: float) -> None:
         if y.shape[0] < 8 or self.delta is not None or self.progressive:  # decided: nothing more to read
             return
         cur = self._fields(y)
-        if self._seen and cur[0].shape != self._seen[-1][0].shape:
+        if self._seen and cur.shape != self._seen[-1].shape:
             self._seen.clear()
+            self._mean = None
         self._seen.append(cur)
         if len(self._seen) < 5:
             return
         self._n += 1
         self._fps = fps
         a = max(1.0 / (TAU * fps), 1.0 / self._n)
-        for side in (0, 1):  # the bottom field against the top, then the top against the bottom
-            far0, before, (ref, other), after, far1 = (f[2 * side] if i != 2 else f[2 * side:2 * side + 2]
-                                                     for i, f in enumerate(self._seen))
-            now = (other / ref - 1.0, (after - before) / (2.0 * ref), (far1 - far0) / (4.0 * ref))
-            mean = self._mean[side] if self._mean is not None else None
-            mean = list(now) if mean is None else [(1 - a) * m + a * v for m, v in zip(mean, now)]
-            self._mean = self._mean or [None, None]
-            self._mean[side] = mean
-            if self._n < 3:
-                continue
-            yy, xx, zz = (v - m for v, m in zip(now, mean))
-            self._sums[side] += (float(np.sum(xx * yy)), float(np.sum(xx * xx)), float(np.sum(yy * yy)), xx.size,
-                                 float(np.sum(zz * yy)), float(np.sum(zz * xx)))
+        # both sides at once: the bottom field against the top, and the top against the bottom
+        far0, before, now_f, after, far1 = (f[0::2] for f in self._seen)
+        ref, other = now_f, self._seen[2][1::2]
+        now = np.empty((3,) + ref.shape, np.float32)  # the ratio, the rate, the rate over 4 frames
+        np.divide(other, ref, out=now[0])
+        now[0] -= 1.0
+        np.subtract(after, before, out=now[1])
+        now[1] /= 2.0 * ref
+        np.subtract(far1, far0, out=now[2])
+        now[2] /= 4.0 * ref
+        if self._mean is None:
+            self._mean = now.copy()
+        else:
+            self._mean *= 1 - a
+            self._mean += a * now
+        if self._n < 3:
+            return
+        now -= self._mean
+        for side in (0, 1):
+            # yy (the ratio), xx (the rate), zz (over 4 frames) against each other: dot products in
+            # float64 (a matrix product of the three takes 4 times as long at these sizes)
+            yy, xx, zz = now[:, side].reshape(3, -1).astype(np.float64)
+            self._sums[side] += (np.dot(xx, yy), np.dot(xx, xx), np.dot(yy, yy), xx.size,
+                                 np.dot(zz, yy), np.dot(zz, xx))
         if self.delta is None and self._n >= MIN_FRAMES and self._n % 4 == 0:
             self._decide()
 
