@@ -171,13 +171,16 @@ def remove_light_changes(x: np.ndarray, offset: np.ndarray | None) -> np.ndarray
     mean = x.mean(axis=-2, keepdims=True)  # (..., bins, 1, 3)
     level = (np.asarray(offset, np.float32)[..., None, :] + mean).astype(np.float64)  # raw mean level
     x = (x - mean).astype(np.float64)
-    bins = x.shape[-3]
-    u = np.full((bins, 1, 1), 1.0 / np.sqrt(bins))
     lc = level - level.mean(axis=-3, keepdims=True)
     norm = np.sqrt(np.sum(lc * lc, axis=-3, keepdims=True))
     # a flat wall (or a plot without its level) has no level direction beyond the constant
     lc = np.where(norm > 1e-6 * np.maximum(np.abs(level).mean(axis=-3, keepdims=True), 1e-9), lc / np.maximum(norm, 1e-30), 0.0)
-    return x - u * np.sum(x * u, axis=-3, keepdims=True) - lc * np.sum(x * lc, axis=-3, keepdims=True)
+    # both directions' components read before either is taken off (they are orthogonal); the
+    # constant's is the mean over the bins; taken off in place, two (bins, T, 3) temporaries fewer
+    along = np.sum(x * lc, axis=-3, keepdims=True)
+    x -= x.mean(axis=-3, keepdims=True)
+    x -= lc * along
+    return x
 
 
 SIGNAL_FLOOR_DB = -30.0
