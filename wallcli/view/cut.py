@@ -88,7 +88,9 @@ class CutWatch:
             share = cv2.resize(ok[:hh, :ww].astype(np.float32), size, interpolation=cv2.INTER_AREA)
             m = share > 0.5  # cells mostly usable: their mean is the usable blocks' mean
             if m.any():
-                step = float(np.sqrt(np.mean((cells[m] / share[m]) ** 2)))
+                x = cells[m] / share[m]
+                # np.mean's float32 sum and division, without its Python wrapper (on every sample)
+                step = float(np.sqrt(np.add.reduce(x * x) / x.size))
         steps = self._steps
         steps.append((t, step))
         n = 2 * CUT_REACH + 1
