@@ -123,6 +123,12 @@ def _grey(planes, roi, max_side: int) -> tuple[np.ndarray, int]:
     return y, w
 
 
+def _sigma_stride(size: int) -> int:
+    """The stride at which :func:`_robust_sigma` reads a difference of ``size`` values (1: all),
+    one rule for it and for :func:`_inner_difference`, which subtracts only those values."""
+    return size // 2048 if size > 4096 else 1
+
+
 def _robust_sigma(d: np.ndarray) -> float:
     """Sigma of one image from a difference of two: the RMS of the smallest 90 % of |d| (of the
     differences the codec coded, see _coded), scaled to a Gaussian's. Not the median: H.264
@@ -131,8 +137,9 @@ def _robust_sigma(d: np.ndarray) -> float:
     d = np.ravel(d)
     if d.size == 0:
         return 0.0
-    if d.size > 4096:  # a fixed stride of the image: as good an estimate for a tenth of the sorting
-        d = d[:: d.size // 2048]
+    step = _sigma_stride(d.size)
+    if step > 1:  # a fixed stride of the image: as good an estimate for a tenth of the sorting
+        d = d[::step]
     d = _coded(d)
     a = np.abs(d - _upper_median(d))
     k = int(0.9 * (a.size - 1))
@@ -225,14 +232,15 @@ _INNER: dict = {}
 
 def _inner_difference(a: np.ndarray, b: np.ndarray, margin: int) -> np.ndarray:
     """``(a - b)[margin:-margin, margin:-margin]`` as far as :func:`_robust_sigma` reads it: over
-    4096 values it reads a fixed stride of them, which are then all that is subtracted (the
+    4096 values it reads a fixed stride of them (_sigma_stride), which are then all that is subtracted (the
     gather's indices kept per shape: the whole difference and its copy were most of the cost)."""
     h, w = a.shape[0] - 2 * margin, a.shape[1] - 2 * margin
-    if h * w <= 4096:
+    step = _sigma_stride(h * w)
+    if step == 1:
         return (a - b)[margin:-margin, margin:-margin]
     key = (a.shape, margin)
     if key not in _INNER:
-        flat = np.arange(0, h * w, (h * w) // 2048)
+        flat = np.arange(0, h * w, step)
         _INNER[key] = (flat // w + margin, flat % w + margin)
     rows, cols = _INNER[key]
     return a[rows, cols] - b[rows, cols]
