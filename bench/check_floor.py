@@ -22,25 +22,13 @@ HERE = Path(__file__).resolve().parent
 
 
 def _off(args: list[str]) -> None:
-    """Run ``wallcli ARGS`` in this process with the checks replaced by pass-throughs."""
+    """Run ``wallcli ARGS`` in this process with the checks replaced by pass-throughs (the same
+    switches as research/speed/ablate.py's)."""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    from wallcli.camera import interlace, overlay, repeats, tnr
-    from wallcli.view import check
+    sys.path.insert(0, str(HERE.parent / "research" / "speed"))
+    from ablate import _switch_off
 
-    def passthrough(self):
-        yield from self.reader.frames()
-
-    def counted(self):
-        for frame in self.reader.frames():
-            self.decoded += 1
-            self.last_time = frame.time
-            yield frame
-
-    overlay.OverlayFilter.frames = passthrough
-    interlace.InterlaceFilter.frames = passthrough
-    repeats.RepeatFilter.frames = counted
-    check.ViewCheck.update = lambda self, t, planes: None
-    tnr.TemporalNoise.__call__ = lambda self, frame: None
+    _switch_off({"overlay", "repeats", "interlace", "tnr", "view"})
     from wallcli.cli.entry import main
 
     sys.argv = ["wallcli", *args]
