@@ -15,6 +15,7 @@ import argparse
 import contextlib
 import io
 import json
+import os
 import resource
 import statistics
 import subprocess
@@ -69,6 +70,9 @@ def _child(clip: str, config: str, command: str) -> None:
             for _ in c.decode(s):
                 pass
     else:
+        # as the CLI's entry does before numpy loads (wallcli/cli/entry.py): OpenBLAS's helper
+        # threads would otherwise spin on the small matrices and be counted as the checks' cost
+        os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
         _switch_off(set(filter(None, config.split(","))))
         from wallcli.cli.app import main
 
